@@ -6,12 +6,13 @@ cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake ninja-build pkg-config git ca-certificates
   libboost1.81-dev libboost-program-options1.81-dev libeigen3-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev nodejs npm chromium gnuplot-nox
+  libgtest-dev libgmock-dev libbenchmark-dev nodejs chromium gnuplot-nox
   libbullet-dev libode-dev libmujoco-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+command -v npm >/dev/null || missing+=(npm)
 if ((${#missing[@]})); then
   echo "setup: installing ${missing[*]}"
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
