@@ -1,0 +1,322 @@
+#include "floor_contact.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <boost/math/tools/toms748_solve.hpp>
+
+#include "integrators.hpp"
+
+namespace tumble {
+namespace {
+
+constexpr int kMaxImpactsPerStep = 32;
+constexpr double kSlop = 1e-12;          // m: deeper than this below the floor is penetration.
+constexpr double kSimultaneous = 1e-9;   // m: vertices this close to the lowest hit together.
+constexpr double kContactBand = 1e-6;    // m: vertices this close to the floor are touching.
+constexpr int kMaxPoints = 8;
+
+using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxPoints, kMaxPoints>;
+using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxPoints, 1>;
+
+/// Body-frame offsets and world velocities of the vertices touching the floor.
+struct ContactSet {
+  int count = 0;
+  std::array<Vec3, kMaxPoints> r;  // world offset from the centre of mass, m
+};
+
+double vertex_y(const BodyState& s, const BodyConstants& c, int i) {
+  return s.x.y() + s.R.row(1).dot(body_vertex(c, i));
+}
+
+ContactSet touching_vertices(const BodyState& s, const BodyConstants& c, double limit_y) {
+  ContactSet set;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 r = s.R * body_vertex(c, i);
+    if (s.x.y() + r.y() <= limit_y) set.r[set.count++] = r;
+  }
+  return set;
+}
+
+/// Kinematic state of the body during an impulse exchange (I⁻¹ is fixed over an impulse).
+struct Kinematics {
+  Vec3 v;
+  Vec3 w;
+  Mat3 inv_inertia;
+  double inv_mass;
+  Vec3 point_velocity(const Vec3& r) const { return v + w.cross(r); }
+  void apply(BodyState& s, const Vec3& r, const Vec3& j) {
+    s.P += j;
+    s.L += r.cross(j);
+    v += inv_mass * j;
+    w += inv_inertia * r.cross(j);
+  }
+};
+
+// Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
+// dynamic simulation of non-penetrating rigid bodies", §4, reduced to equality targets).
+// Every active contact i gets v⁺ₙ = −eᵢ v⁻ₙ and a non-negative impulse; a contact that would
+// pull is dropped, a passive one that would approach is added. K is singular for four
+// coplanar contacts (a flat face has three normal degrees of freedom), so the solve uses the
+// pseudo-inverse; rigid-body targets are then consistent and the flat landing stays flat.
+// With e = 1 every active contact reverses its normal velocity, which conserves kinetic
+// energy exactly: ΔT = Σ jᵢ (v⁻ᵢ + v⁺ᵢ)/2 = 0.
+std::array<double, kMaxPoints> solve_normal(BodyState& s, Kinematics& k, const ContactSet& set,
+                                           double e, double rest_speed_ms) {
+  const int n = set.count;
+  PointMatrix K(n, n);
+  PointVector vn(n), target(n);
+  const Vec3 up = Vec3::UnitY();
+  for (int i = 0; i < n; ++i) {
+    vn(i) = k.point_velocity(set.r[i]).y();
+    const double ei = (e * -vn(i) < rest_speed_ms) ? 0.0 : e;
+    target(i) = vn(i) < 0.0 ? -ei * vn(i) : 0.0;
+    for (int j = 0; j < n; ++j)
+      K(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
+  }
+  std::array<bool, kMaxPoints> active{};
+  for (int i = 0; i < n; ++i) active[i] = vn(i) < 0.0;
+  PointVector impulse = PointVector::Zero(n);
+  for (int iter = 0; iter < 4 * kMaxPoints; ++iter) {
+    std::array<int, kMaxPoints> idx{};
+    int m = 0;
+    for (int i = 0; i < n; ++i)
+      if (active[i]) idx[m++] = i;
+    impulse.setZero();
+    if (m > 0) {
+      PointMatrix Ka(m, m);
+      PointVector b(m);
+      for (int a = 0; a < m; ++a) {
+        b(a) = target(idx[a]) - vn(idx[a]);
+        for (int c = 0; c < m; ++c) Ka(a, c) = K(idx[a], idx[c]);
+      }
+      Eigen::SelfAdjointEigenSolver<PointMatrix> eig(Ka);
+      const PointVector lambda = eig.eigenvalues();
+      const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
+      PointVector y = eig.eigenvectors().transpose() * b;
+      for (int a = 0; a < m; ++a) y(a) = std::abs(lambda(a)) > cutoff ? y(a) / lambda(a) : 0.0;
+      const PointVector ja = eig.eigenvectors() * y;
+      for (int a = 0; a < m; ++a) impulse(idx[a]) = ja(a);
+    }
+    // Drop the most negative impulse, else add the most violated passive contact.
+    int worst = -1;
+    double worst_value = -1e-14;
+    for (int i = 0; i < n; ++i)
+      if (active[i] && impulse(i) < worst_value) worst = i, worst_value = impulse(i);
+    if (worst >= 0) {
+      active[worst] = false;
+      continue;
+    }
+    const PointVector after = vn + K * impulse;
+    worst_value = -1e-12;
+    for (int i = 0; i < n; ++i)
+      if (!active[i] && after(i) < worst_value) worst = i, worst_value = after(i);
+    if (worst < 0) break;
+    active[worst] = true;
+    target(worst) = 0.0;
+  }
+  std::array<double, kMaxPoints> applied{};
+  for (int i = 0; i < n; ++i) {
+    if (impulse(i) <= 0.0) continue;
+    k.apply(s, set.r[i], impulse(i) * up);
+    applied[i] = impulse(i);
+  }
+  return applied;
+}
+
+// Coulomb friction by projected Gauss–Seidel over the contacts that carry a normal impulse:
+// each tangential impulse cancels its contact's sliding velocity through the contact's own
+// 2×2 tangential mass, clamped to the cone |jₜ| ≤ μ jₙ (Catto, "Iterative dynamics with
+// temporal coherence", GDC 2005). Each update is a clamped projection, so it never adds
+// kinetic energy.
+void solve_friction(BodyState& s, Kinematics& k, const ContactSet& set,
+                    const std::array<double, kMaxPoints>& normal, double mu) {
+  std::array<Eigen::Vector2d, kMaxPoints> accumulated{};
+  for (auto& a : accumulated) a.setZero();
+  for (int sweep = 0; sweep < 8; ++sweep) {
+    for (int i = 0; i < set.count; ++i) {
+      if (normal[i] <= 0.0) continue;
+      const Vec3& r = set.r[i];
+      const Mat3 rx = skew(r);
+      const Mat3 mass3 = k.inv_mass * Mat3::Identity() - rx * k.inv_inertia * rx;
+      Eigen::Matrix2d kt;
+      kt << mass3(0, 0), mass3(0, 2), mass3(2, 0), mass3(2, 2);
+      const Vec3 u = k.point_velocity(r);
+      const Eigen::Vector2d ut(u.x(), u.z());
+      Eigen::Vector2d next = accumulated[i] - kt.inverse() * ut;
+      const double limit = mu * normal[i];
+      if (next.norm() > limit) next *= limit / next.norm();
+      const Eigen::Vector2d delta = next - accumulated[i];
+      accumulated[i] = next;
+      k.apply(s, r, Vec3(delta.x(), 0.0, delta.y()));
+    }
+  }
+}
+
+Kinematics kinematics_of(const BodyState& s, const BodyConstants& c) {
+  Kinematics k;
+  k.inv_mass = c.inv_mass;
+  k.inv_inertia = inverse_inertia_world(s, c);
+  k.v = s.P * c.inv_mass;
+  k.w = k.inv_inertia * s.L;
+  return k;
+}
+
+int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, double e, double mu,
+            double rest_speed_ms) {
+  if (set.count == 0) return 0;
+  Kinematics k = kinematics_of(s, c);
+  const std::array<double, kMaxPoints> normal = solve_normal(s, k, set, e, rest_speed_ms);
+  if (mu > 0.0) {
+    solve_friction(s, k, set, normal, mu);
+    solve_normal(s, k, set, 0.0, rest_speed_ms);  // friction may tilt a contact inward
+  }
+  return set.count;
+}
+
+bool in_resting_contact(const BodyState& s, const BodyConstants& c, double floor_y,
+                        double rest_speed_ms) {
+  if (lowest_vertex_y(s, c) > floor_y + kContactBand) return false;
+  const Kinematics k = kinematics_of(s, c);
+  const ContactSet set = touching_vertices(s, c, floor_y + kContactBand);
+  for (int i = 0; i < set.count; ++i)
+    if (k.point_velocity(set.r[i]).y() <= rest_speed_ms) return true;
+  return false;
+}
+
+// Resting contact over h seconds, a velocity-level step in the spirit of Guendelman, Bridson
+// & Fedkiw 2003 (§5–6): gravity first, then inelastic contact impulses (with friction) on the
+// touching vertices, then positions with the corrected velocities. A flat box ends with v = 0
+// and x unchanged: no sinking, no jitter. A vertex the rotation carried below the floor is
+// projected back and its approach removed.
+void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
+                  double h, double rest_speed_ms) {
+  s.P += (h * c.mass) * gravity;
+  resolve(s, c, touching_vertices(s, c, floor_y + kContactBand), 0.0, c.friction, rest_speed_ms);
+  s.x += (h * c.inv_mass) * s.P;
+  if (!s.L.isZero()) {
+    s.R = rotation_from_vector(h * angular_velocity(s, c)) * s.R;
+    orthonormalize(s.R);
+  }
+  const double lowest = lowest_vertex_y(s, c);
+  if (lowest < floor_y) {
+    s.x.y() += floor_y - lowest;
+    resolve(s, c, touching_vertices(s, c, floor_y + kSimultaneous), 0.0, c.friction,
+            rest_speed_ms);
+  }
+}
+
+/// Earliest time in [0, h] at which a vertex of `mask` reaches the floor (it is above at 0
+/// and some vertex of the mask is below at h). Returns the non-penetrating end of the final
+/// bracket, so a body is never left inside the floor.
+double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef& w,
+                      double floor_y, double h, unsigned mask, double height_at_h,
+                      int& evaluations) {
+  auto height = [&](double t) {
+    ++evaluations;
+    const BodyState st = advance(w.integrator, s, c, w.gravity, t);
+    if (mask == 0xFF) return lowest_vertex_y(st, c) - floor_y;
+    double lowest = INFINITY;
+    for (int i = 0; i < 8; ++i)
+      if (mask & (1u << i)) lowest = std::min(lowest, vertex_y(st, c, i));
+    return lowest - floor_y;
+  };
+  if (w.toi == ToiMethod::bisection) {
+    // The seed's search: halve the interval, keeping the last time that does not penetrate.
+    double lo = 0.0, hi = h;
+    while (hi - lo > w.toi_tolerance) {
+      const double mid = 0.5 * (lo + hi);
+      (height(mid) < 0.0 ? hi : lo) = mid;
+    }
+    return lo;
+  }
+  // TOMS 748 (Alefeld, Potra & Shi 1995) on the lowest-vertex height along the trajectory:
+  // cubic inverse interpolation with bracketing, a few evaluations where bisection takes
+  // log2(h / tolerance). The lower end keeps the sign of height(0) > 0.
+  const double h0 = height(0.0);
+  std::uintmax_t max_iter = 100;
+  const double tol = w.toi_tolerance;
+  const auto bracket = boost::math::tools::toms748_solve(
+      height, 0.0, h, h0, height_at_h, [tol](double a, double b) { return b - a <= tol; },
+      max_iter);
+  return bracket.first;
+}
+
+unsigned vertices_above(const BodyState& s, const BodyConstants& c, double y) {
+  unsigned mask = 0;
+  for (int i = 0; i < 8; ++i)
+    if (vertex_y(s, c, i) > y) mask |= 1u << i;
+  return mask;
+}
+
+}  // namespace
+
+double rest_speed(double restitution, const Vec3& gravity, double dt) {
+  return restitution >= 1.0 ? 1e-6 : 0.5 * gravity.norm() * dt;
+}
+
+int resolve_floor_impact(BodyState& s, const BodyConstants& c, double floor_height,
+                         double restitution, double friction, double rest_speed_ms) {
+  const double limit = std::max(lowest_vertex_y(s, c), floor_height) + kSimultaneous;
+  return resolve(s, c, touching_vertices(s, c, limit), restitution, friction, rest_speed_ms);
+}
+
+FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
+  FloorStepResult result;
+  BodyState& s = body.s;
+  const BodyConstants& c = body.c;
+  if (!w.floor) {
+    s = advance(w.integrator, s, c, w.gravity, dt);
+    return result;
+  }
+  const double floor_y = w.floor->height;
+  const double vrest = rest_speed(c.restitution, w.gravity, w.dt);
+  double remaining = dt;
+  for (int k = 0; k < kMaxImpactsPerStep && remaining > 1e-15; ++k) {
+    // Bounding sphere clear of the floor at both ends: no vertex test (the flight path's
+    // lowest point is at an end while gravity points down).
+    const bool start_clear = s.x.y() - c.bounding_radius > floor_y;
+    if (!start_clear && in_resting_contact(s, c, floor_y, vrest)) {
+      contact_step(s, c, w.gravity, floor_y, remaining, vrest);
+      result.touched = true;
+      return result;
+    }
+    const BodyState next = advance(w.integrator, s, c, w.gravity, remaining);
+    if (next.x.y() - c.bounding_radius > floor_y && (start_clear || w.gravity.y() <= 0.0)) {
+      s = next;
+      return result;
+    }
+    const double end_height = lowest_vertex_y(next, c) - floor_y;
+    if (end_height >= -kSlop) {
+      s = next;
+      return result;
+    }
+    const unsigned mask = vertices_above(s, c, floor_y + kSlop);
+    if ((vertices_above(next, c, floor_y - kSlop) | mask) != 0xFF) {
+      // A vertex that started on the floor ends inside it: resting contact, not an impact.
+      break;
+    }
+    double masked_end = end_height;
+    if (mask != 0xFF) {
+      masked_end = INFINITY;
+      for (int i = 0; i < 8; ++i)
+        if (mask & (1u << i)) masked_end = std::min(masked_end, vertex_y(next, c, i) - floor_y);
+    }
+    const double t = time_of_impact(s, c, w, floor_y, remaining, mask, masked_end,
+                                    result.toi_iterations);
+    if (t > 0.0) s = advance(w.integrator, s, c, w.gravity, t);
+    resolve_floor_impact(s, c, floor_y, c.restitution, c.friction, vrest);
+    ++result.impacts;
+    result.touched = true;
+    remaining -= t;
+  }
+  if (remaining > 1e-15) {
+    contact_step(s, c, w.gravity, floor_y, remaining, vrest);
+    result.touched = true;
+  }
+  return result;
+}
+
+}  // namespace tumble

@@ -1,0 +1,36 @@
+#pragma once
+/// Bodies against the floor plane y = h: time of impact, impulses, resting contact.
+/// Pure functions over one body; thread-safe.
+#include "tumble/body.hpp"
+#include "tumble/scene.hpp"
+
+namespace tumble {
+
+/// What one body's step cost and met.
+struct FloorStepResult {
+  int impacts = 0;         ///< Impacts resolved (several may fall in one step).
+  int toi_iterations = 0;  ///< Partial-step evaluations spent locating them.
+  bool touched = false;    ///< The body was in contact with the floor at some point.
+};
+
+/// Height of the lowest vertex above the plane y = 0 (metres): x_y − Σ |R_1k| h_k.
+inline double lowest_vertex_y(const BodyState& s, const BodyConstants& c) {
+  return s.x.y() - (s.R.row(1).cwiseAbs().dot(c.half_extents));
+}
+
+/// Speed below which an impact rebounds with e = 0 and contact becomes resting contact
+/// (m/s): half the speed gravity adds in one step, so a bounce shorter than about one step
+/// ends the Zeno series. Perfectly elastic bodies (e = 1) keep bouncing down to 1e-6 m/s.
+double rest_speed(double restitution, const Vec3& gravity, double dt);
+
+/// Advances one awake body by dt: flight with the world's integrator, impacts located by
+/// the world's TOI method and answered with impulses, resting contact without sinking.
+FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt);
+
+/// Applies simultaneous impulses at the vertices touching the floor (within 1e-9 m of the
+/// lowest) so that no contact approaches: restitution e, Coulomb friction μ. Returns the
+/// number of vertices that received an impulse.
+int resolve_floor_impact(BodyState& s, const BodyConstants& c, double floor_height,
+                         double restitution, double friction, double rest_speed_ms);
+
+}  // namespace tumble

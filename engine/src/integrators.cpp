@@ -1,0 +1,106 @@
+#include "integrators.hpp"
+
+#include "free_rotation.hpp"
+
+namespace tumble {
+namespace {
+
+/// dY/dt of the seed, Y = (x, R, P, L): (v, ω* R, F, τ) with F = m g and τ = 0.
+struct Derivative {
+  Vec3 dx;
+  Mat3 dR;
+  Vec3 dP;
+};
+
+Derivative derivative(const BodyState& s, const BodyConstants& c, const Vec3& gravity) {
+  // I⁻¹ = R I_body⁻¹ Rᵀ as in the seed; R need not be orthonormal at the stages.
+  const Vec3 w = s.R * c.inv_inertia.cwiseProduct(s.R.transpose() * s.L);
+  return {s.P * c.inv_mass, skew(w) * s.R, c.mass * gravity};
+}
+
+BodyState add(const BodyState& s, const Derivative& d, double h) {
+  BodyState r;
+  r.x = s.x + h * d.dx;
+  r.R = s.R + h * d.dR;
+  r.P = s.P + h * d.dP;
+  r.L = s.L;
+  return r;
+}
+
+BodyState euler(const BodyState& s, const BodyConstants& c, const Vec3& g, double h) {
+  BodyState r = add(s, derivative(s, c, g), h);
+  orthonormalize(r.R);
+  return r;
+}
+
+// The seed's second-order step: an Euler half step, then the full step with the derivative
+// evaluated at that midpoint (Baraff & Witkin's "midpoint method").
+BodyState midpoint(const BodyState& s, const BodyConstants& c, const Vec3& g, double h) {
+  const BodyState half = add(s, derivative(s, c, g), 0.5 * h);
+  BodyState r = add(s, derivative(half, c, g), h);
+  orthonormalize(r.R);
+  return r;
+}
+
+BodyState rk4(const BodyState& s, const BodyConstants& c, const Vec3& g, double h) {
+  const Derivative k1 = derivative(s, c, g);
+  const Derivative k2 = derivative(add(s, k1, 0.5 * h), c, g);
+  const Derivative k3 = derivative(add(s, k2, 0.5 * h), c, g);
+  const Derivative k4 = derivative(add(s, k3, h), c, g);
+  BodyState r;
+  r.x = s.x + h / 6.0 * (k1.dx + 2.0 * k2.dx + 2.0 * k3.dx + k4.dx);
+  r.R = s.R + h / 6.0 * (k1.dR + 2.0 * k2.dR + 2.0 * k3.dR + k4.dR);
+  r.P = s.P + h / 6.0 * (k1.dP + 2.0 * k2.dP + 2.0 * k3.dP + k4.dP);
+  r.L = s.L;
+  orthonormalize(r.R);
+  return r;
+}
+
+// Semi-implicit Euler as game engines use it: momentum first, then position with the new
+// velocity and orientation by the exponential map of the (old-R) angular velocity.
+BodyState symplectic_euler(const BodyState& s, const BodyConstants& c, const Vec3& g, double h) {
+  BodyState r = s;
+  r.P = s.P + h * c.mass * g;
+  r.x = s.x + h * c.inv_mass * r.P;
+  if (!s.L.isZero()) {
+    r.R = rotation_from_vector(h * angular_velocity(s, c)) * s.R;
+    orthonormalize(r.R);
+  }
+  return r;
+}
+
+// Ballistic translation in closed form: x(h) = x + v h + ½ g h², P(h) = P + m g h.
+void ballistic(BodyState& r, const BodyState& s, const BodyConstants& c, const Vec3& g, double h) {
+  r.x = s.x + h * (c.inv_mass * s.P) + (0.5 * h * h) * g;
+  r.P = s.P + (h * c.mass) * g;
+}
+
+}  // namespace
+
+BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
+                  const Vec3& gravity, double h) {
+  switch (integrator) {
+    case Integrator::euler: return euler(s, c, gravity, h);
+    case Integrator::midpoint: return midpoint(s, c, gravity, h);
+    case Integrator::rk4: return rk4(s, c, gravity, h);
+    case Integrator::symplectic_euler: return symplectic_euler(s, c, gravity, h);
+    case Integrator::splitting:
+    case Integrator::exact: break;
+  }
+  BodyState r;
+  ballistic(r, s, c, gravity, h);
+  r.L = s.L;
+  if (s.L.isZero()) {
+    r.R = s.R;  // No spin: nothing to rotate.
+  } else if (integrator == Integrator::exact) {
+    r.R = free_rotation_exact(c.inertia, s.R, s.L, h);
+  } else {
+    r.R = free_rotation_splitting(c.inertia, s.R, s.L, h);
+  }
+  // Products of exact rotations still gather round-off; one polar step keeps ‖RᵀR − I‖ at
+  // 1e-15 over millions of steps for about 60 flops.
+  if (!s.L.isZero()) orthonormalize(r.R);
+  return r;
+}
+
+}  // namespace tumble
