@@ -55,29 +55,41 @@ struct Kinematics {
   }
 };
 
+using Impulses = std::array<double, kMaxPoints>;
+
+/// Normal velocity each contact should leave with if it is pushed: −eᵢ v⁻ₙ for an approaching
+/// contact (e = 0 below the rest speed, which ends a Zeno series), 0 for a resting one.
+Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
+                        double rest_speed_ms) {
+  Impulses target{};
+  for (int i = 0; i < set.count; ++i) {
+    const double vn = k.point_velocity(set.r[i]).y();
+    const double ei = (e * -vn < rest_speed_ms) ? 0.0 : e;
+    target[i] = vn < 0.0 ? -ei * vn : 0.0;
+  }
+  return target;
+}
+
 // Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
-// dynamic simulation of non-penetrating rigid bodies", §4, reduced to equality targets).
-// Every active contact i gets v⁺ₙ = −eᵢ v⁻ₙ and a non-negative impulse; a contact that would
-// pull is dropped, a passive one that would approach is added. K is singular for four
-// coplanar contacts (a flat face has three normal degrees of freedom), so the solve uses the
-// pseudo-inverse; rigid-body targets are then consistent and the flat landing stays flat.
-// With e = 1 every active contact reverses its normal velocity, which conserves kinetic
+// dynamic simulation of non-penetrating rigid bodies", §4, with equality targets).
+// Every active contact i leaves with v⁺ₙ = targetᵢ and a non-negative impulse; a contact
+// that would pull is dropped, a passive one that would approach is added. K is singular for
+// four coplanar contacts (a flat face has three normal degrees of freedom), so the solve
+// uses the pseudo-inverse; rigid-body targets are then consistent and a flat landing stays
+// flat. With e = 1 every active contact reverses its normal velocity, which conserves kinetic
 // energy exactly: ΔT = Σ jᵢ (v⁻ᵢ + v⁺ᵢ)/2 = 0.
-std::array<double, kMaxPoints> solve_normal(BodyState& s, Kinematics& k, const ContactSet& set,
-                                           double e, double rest_speed_ms) {
+Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, const Impulses& target) {
   const int n = set.count;
   PointMatrix K(n, n);
-  PointVector vn(n), target(n);
+  PointVector vn(n);
   const Vec3 up = Vec3::UnitY();
   for (int i = 0; i < n; ++i) {
     vn(i) = k.point_velocity(set.r[i]).y();
-    const double ei = (e * -vn(i) < rest_speed_ms) ? 0.0 : e;
-    target(i) = vn(i) < 0.0 ? -ei * vn(i) : 0.0;
     for (int j = 0; j < n; ++j)
       K(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
   }
   std::array<bool, kMaxPoints> active{};
-  for (int i = 0; i < n; ++i) active[i] = vn(i) < 0.0;
+  for (int i = 0; i < n; ++i) active[i] = vn(i) < target[i] - 1e-15;
   PointVector impulse = PointVector::Zero(n);
   for (int iter = 0; iter < 4 * kMaxPoints; ++iter) {
     std::array<int, kMaxPoints> idx{};
@@ -89,7 +101,7 @@ std::array<double, kMaxPoints> solve_normal(BodyState& s, Kinematics& k, const C
       PointMatrix Ka(m, m);
       PointVector b(m);
       for (int a = 0; a < m; ++a) {
-        b(a) = target(idx[a]) - vn(idx[a]);
+        b(a) = target[idx[a]] - vn(idx[a]);
         for (int c = 0; c < m; ++c) Ka(a, c) = K(idx[a], idx[c]);
       }
       Eigen::SelfAdjointEigenSolver<PointMatrix> eig(Ka);
@@ -112,47 +124,17 @@ std::array<double, kMaxPoints> solve_normal(BodyState& s, Kinematics& k, const C
     const PointVector after = vn + K * impulse;
     worst_value = -1e-12;
     for (int i = 0; i < n; ++i)
-      if (!active[i] && after(i) < worst_value) worst = i, worst_value = after(i);
+      if (!active[i] && after(i) - target[i] < worst_value) worst = i, worst_value = after(i) - target[i];
     if (worst < 0) break;
     active[worst] = true;
-    target(worst) = 0.0;
   }
-  std::array<double, kMaxPoints> applied{};
+  Impulses applied{};
   for (int i = 0; i < n; ++i) {
     if (impulse(i) <= 0.0) continue;
     k.apply(s, set.r[i], impulse(i) * up);
     applied[i] = impulse(i);
   }
   return applied;
-}
-
-// Coulomb friction by projected Gauss–Seidel over the contacts that carry a normal impulse:
-// each tangential impulse cancels its contact's sliding velocity through the contact's own
-// 2×2 tangential mass, clamped to the cone |jₜ| ≤ μ jₙ (Catto, "Iterative dynamics with
-// temporal coherence", GDC 2005). Each update is a clamped projection, so it never adds
-// kinetic energy.
-void solve_friction(BodyState& s, Kinematics& k, const ContactSet& set,
-                    const std::array<double, kMaxPoints>& normal, double mu) {
-  std::array<Eigen::Vector2d, kMaxPoints> accumulated{};
-  for (auto& a : accumulated) a.setZero();
-  for (int sweep = 0; sweep < 8; ++sweep) {
-    for (int i = 0; i < set.count; ++i) {
-      if (normal[i] <= 0.0) continue;
-      const Vec3& r = set.r[i];
-      const Mat3 rx = skew(r);
-      const Mat3 mass3 = k.inv_mass * Mat3::Identity() - rx * k.inv_inertia * rx;
-      Eigen::Matrix2d kt;
-      kt << mass3(0, 0), mass3(0, 2), mass3(2, 0), mass3(2, 2);
-      const Vec3 u = k.point_velocity(r);
-      const Eigen::Vector2d ut(u.x(), u.z());
-      Eigen::Vector2d next = accumulated[i] - kt.inverse() * ut;
-      const double limit = mu * normal[i];
-      if (next.norm() > limit) next *= limit / next.norm();
-      const Eigen::Vector2d delta = next - accumulated[i];
-      accumulated[i] = next;
-      k.apply(s, r, Vec3(delta.x(), 0.0, delta.y()));
-    }
-  }
 }
 
 Kinematics kinematics_of(const BodyState& s, const BodyConstants& c) {
@@ -164,14 +146,42 @@ Kinematics kinematics_of(const BodyState& s, const BodyConstants& c) {
   return k;
 }
 
-int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, double e, double mu,
-            double rest_speed_ms) {
+// Coulomb friction on the contact patch as a whole, alternated with the exact normal solve
+// to a fixed point: the tangential impulse F acts at the normal-impulse-weighted centroid of
+// the contacts, cancels the sliding velocity there through its 2×2 tangential mass, and is
+// clamped to the cone |F| ≤ μ Σ jₙ (Stewart & Trinkle 1996 reduce to this for one patch).
+// Each round re-solves the normal impulses from the state before the impulse exchange, so the
+// load shifts to the leading edge of a sliding box instead of tipping it, and a flat slide
+// decelerates at exactly μ g.
+int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const Impulses& target,
+            double mu) {
   if (set.count == 0) return 0;
-  Kinematics k = kinematics_of(s, c);
-  const std::array<double, kMaxPoints> normal = solve_normal(s, k, set, e, rest_speed_ms);
-  if (mu > 0.0) {
-    solve_friction(s, k, set, normal, mu);
-    solve_normal(s, k, set, 0.0, rest_speed_ms);  // friction may tilt a contact inward
+  const BodyState s0 = s;
+  const Kinematics k0 = kinematics_of(s, c);
+  Kinematics k = k0;
+  Impulses normal = solve_normal(s, k, set, target);
+  if (mu <= 0.0) return set.count;
+  Eigen::Vector2d friction = Eigen::Vector2d::Zero();
+  for (int round = 0; round < 16; ++round) {
+    double total = 0.0;
+    Vec3 centroid = Vec3::Zero();
+    for (int i = 0; i < set.count; ++i) total += normal[i], centroid += normal[i] * set.r[i];
+    if (total <= 0.0) break;
+    centroid /= total;
+    const Mat3 rx = skew(centroid);
+    const Mat3 mass3 = k.inv_mass * Mat3::Identity() - rx * k.inv_inertia * rx;
+    Eigen::Matrix2d kt;
+    kt << mass3(0, 0), mass3(0, 2), mass3(2, 0), mass3(2, 2);
+    const Vec3 u = k.point_velocity(centroid);
+    Eigen::Vector2d next = friction - kt.inverse() * Eigen::Vector2d(u.x(), u.z());
+    if (next.norm() > mu * total) next *= mu * total / next.norm();
+    const bool settled = (next - friction).norm() <= 1e-13 * (1.0 + next.norm());
+    friction = next;
+    s = s0;
+    k = k0;
+    k.apply(s, centroid, Vec3(friction.x(), 0.0, friction.y()));
+    normal = solve_normal(s, k, set, target);
+    if (settled) break;
   }
   return set.count;
 }
@@ -187,14 +197,30 @@ bool in_resting_contact(const BodyState& s, const BodyConstants& c, double floor
 }
 
 // Resting contact over h seconds, a velocity-level step in the spirit of Guendelman, Bridson
-// & Fedkiw 2003 (§5–6): gravity first, then inelastic contact impulses (with friction) on the
-// touching vertices, then positions with the corrected velocities. A flat box ends with v = 0
-// and x unchanged: no sinking, no jitter. A vertex the rotation carried below the floor is
-// projected back and its approach removed.
+// & Fedkiw 2003 (§5–6): gravity first, then inelastic contact impulses (with friction), then
+// positions with the corrected velocities. Touching vertices may not approach; a vertex that
+// would reach the floor within the step may approach only by its gap (a speculative contact,
+// as in Box2D and Jolt), so a rocking box lands flat at the end of the step instead of
+// rotating through the floor and being pushed out. A flat box ends with v = 0 and x
+// unchanged: no sinking, no jitter. What round-off or the rotation's curvature leaves below
+// the floor is projected back and its approach removed.
 void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
-                  double h, double rest_speed_ms) {
+                  double h) {
   s.P += (h * c.mass) * gravity;
-  resolve(s, c, touching_vertices(s, c, floor_y + kContactBand), 0.0, c.friction, rest_speed_ms);
+  {
+    const Kinematics k = kinematics_of(s, c);
+    ContactSet set;
+    Impulses target{};
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 r = s.R * body_vertex(c, i);
+      const double gap = s.x.y() + r.y() - floor_y;
+      const double vn = k.point_velocity(r).y();
+      if (gap > kContactBand && gap + h * vn >= 0.0) continue;
+      target[set.count] = gap <= kContactBand ? 0.0 : -gap / h;
+      set.r[set.count++] = r;
+    }
+    resolve(s, c, set, target, c.friction);
+  }
   s.x += (h * c.inv_mass) * s.P;
   if (!s.L.isZero()) {
     s.R = rotation_from_vector(h * angular_velocity(s, c)) * s.R;
@@ -203,8 +229,8 @@ void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, dou
   const double lowest = lowest_vertex_y(s, c);
   if (lowest < floor_y) {
     s.x.y() += floor_y - lowest;
-    resolve(s, c, touching_vertices(s, c, floor_y + kSimultaneous), 0.0, c.friction,
-            rest_speed_ms);
+    const ContactSet set = touching_vertices(s, c, floor_y + kSimultaneous);
+    resolve(s, c, set, Impulses{}, c.friction);
   }
 }
 
@@ -260,7 +286,9 @@ double rest_speed(double restitution, const Vec3& gravity, double dt) {
 int resolve_floor_impact(BodyState& s, const BodyConstants& c, double floor_height,
                          double restitution, double friction, double rest_speed_ms) {
   const double limit = std::max(lowest_vertex_y(s, c), floor_height) + kSimultaneous;
-  return resolve(s, c, touching_vertices(s, c, limit), restitution, friction, rest_speed_ms);
+  const ContactSet set = touching_vertices(s, c, limit);
+  const Impulses target = normal_targets(kinematics_of(s, c), set, restitution, rest_speed_ms);
+  return resolve(s, c, set, target, friction);
 }
 
 FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
@@ -279,7 +307,7 @@ FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
     // lowest point is at an end while gravity points down).
     const bool start_clear = s.x.y() - c.bounding_radius > floor_y;
     if (!start_clear && in_resting_contact(s, c, floor_y, vrest)) {
-      contact_step(s, c, w.gravity, floor_y, remaining, vrest);
+      contact_step(s, c, w.gravity, floor_y, remaining);
       result.touched = true;
       return result;
     }
@@ -313,7 +341,7 @@ FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
     remaining -= t;
   }
   if (remaining > 1e-15) {
-    contact_step(s, c, w.gravity, floor_y, remaining, vrest);
+    contact_step(s, c, w.gravity, floor_y, remaining);
     result.touched = true;
   }
   return result;

@@ -80,6 +80,23 @@ struct JacobiAgm {
     // dn² = cn² + k'² sn² has no cancellation, unlike 1 − k² sn² near u = K, k → 1.
     dn = std::sqrt(cn * cn + kc * kc * sn * sn);
   }
+
+  // sn, cn, dn at r ∈ [−K, K]. Near r = ±K the amplitude is near ±π/2 and cos of it keeps only
+  // an absolute precision, while close to the separatrix cn and dn there are O(k') small and the
+  // elliptic integrals depend on their logarithms. So for |r| > K/2 evaluate at v = K − |r| and
+  // reflect: sn(K − v) = cn v / dn v, cn(K − v) = k' sn v / dn v, dn(K − v) = k' / dn v
+  // (DLMF 22.4.3), which keeps cn and dn to relative precision.
+  void eval_reduced(double r, double kc, double& sn, double& cn, double& dn) const {
+    if (std::abs(r) <= 0.5 * quarter_period) {
+      eval(r, kc, sn, cn, dn);
+      return;
+    }
+    double s, c, d;
+    eval(quarter_period - std::abs(r), kc, s, c, d);
+    sn = std::copysign(c / d, r);
+    cn = kc * s / d;
+    dn = kc / d;
+  }
 };
 
 // The rotation P(m) (body → a frame whose z axis is m), rows e1 = (m2, −m1, 0)/ρ,
@@ -190,7 +207,7 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
       const double w = r0 + lambda * t;
       const double half_periods = std::nearbyint(w / (2.0 * K));
       r = w - 2.0 * half_periods * K;
-      agm.eval(r, kc, sn, cn, dn);
+      agm.eval_reduced(r, kc, sn, cn, dn);
       if (half_periods != 0.0) {
         rj_periods = 2.0 * half_periods * carlson_rj(0.0, kc2, 1.0, 1.0 - n);
         j += static_cast<int>(std::fmod(half_periods, 2.0));

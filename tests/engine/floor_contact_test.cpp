@@ -1,0 +1,164 @@
+// Impacts with the floor: apex heights, energy, flat landings, rest, sleep, friction.
+#include <cmath>
+#include <vector>
+
+#include "floor_contact.hpp"
+#include "world_fixture.hpp"
+
+namespace tumble {
+namespace {
+
+constexpr double kG = 9.81;
+
+/// Apex of the lowest vertex predicted from a flight state: y + v_y² / 2g (exact in flight).
+double apex_of(const Body& b) {
+  const double vy = b.s.P.y() * b.c.inv_mass;
+  return lowest_vertex_y(b.s, b.c) + vy * vy / (2.0 * kG);
+}
+
+/// The apexes after each of the first `count` impacts of a world's body 0.
+std::vector<double> apexes(World& world, std::size_t count, int max_steps = 2000) {
+  std::vector<double> result;
+  std::uint64_t seen = 0;
+  for (int i = 0; i < max_steps && result.size() < count; ++i) {
+    world.step();
+    if (world.total_impacts() > seen && world.body(0).s.P.y() > 0.0) {
+      seen = world.total_impacts();
+      result.push_back(apex_of(world.body(0)));
+    }
+  }
+  return result;
+}
+
+// A flat cube dropped from 1 m with e = 0.5 rebounds to h e^(2k): 0.25, 0.0625, 0.015625 m.
+// Flight is exact and the impact time is found to 1e-12 s, so the apexes are exact to ~1e-12.
+TEST(Bounce, FlatCubeApexesFollowRestitutionSquared) {
+  for (ToiMethod toi : {ToiMethod::root, ToiMethod::bisection}) {
+    Scene scene = load_scene("bounce");
+    scene.world.toi = toi;
+    World world(scene);
+    const auto a = apexes(world, 3);
+    ASSERT_EQ(a.size(), 3u);
+    const double expected[] = {0.25, 0.0625, 0.015625};
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(a[k] / expected[k], 1.0, 1e-9) << to_string(toi) << " apex " << k;
+      std::cout << "[ measured ] " << to_string(toi) << " apex " << k << " = " << a[k]
+                << " (relative error " << std::abs(a[k] / expected[k] - 1.0) << ")\n";
+    }
+    // A flat landing stays flat: no spin is ever created.
+    EXPECT_LT(world.body(0).s.L.norm(), 1e-12);
+    EXPECT_LT(rotation_angle_between(Mat3::Identity(), world.body(0).s.R), 1e-12);
+  }
+}
+
+// The Zeno series ends: a bounded number of impacts, then rest and sleep, never below the floor.
+TEST(Bounce, ComesToRestInBoundedImpactsWithoutSinking) {
+  for (double e : {0.0, 0.5, 0.9}) {
+    Scene scene = load_scene("bounce");
+    scene.world.floor->restitution = e;
+    World world(scene);
+    double deepest = 0.0;
+    int steps = 0;
+    while (world.body(0).activity == Activity::awake && steps < 30 * 60) {
+      world.step();
+      ++steps;
+      deepest = std::min(deepest, lowest_vertex_y(world.body(0).s, world.body(0).c));
+    }
+    EXPECT_EQ(world.body(0).activity, Activity::asleep) << "e = " << e;
+    EXPECT_LE(world.total_impacts(), 60u) << "e = " << e;
+    EXPECT_GE(deepest, -1e-9) << "e = " << e;
+    std::cout << "[ measured ] e = " << e << ": " << world.total_impacts() << " impacts, asleep at "
+              << world.time() << " s, deepest " << deepest << " m\n";
+    // Rest is exact: on the floor, not moving, no energy above the resting value.
+    const Body& b = world.body(0);
+    EXPECT_NEAR(lowest_vertex_y(b.s, b.c), 0.0, 1e-9);
+    EXPECT_LE(world.total_energy(), 1.0 * kG * 0.5 + 1e-9);
+  }
+}
+
+// The seed's scene with e = 1, μ = 0 and the exact flight keeps its energy over 600 s:
+// impacts reverse every active contact's normal velocity (ΔT = 0) and flight is closed-form.
+TEST(SeedScene, ExactIntegratorConservesEnergyOver600Seconds) {
+  Scene scene = load_scene("seed");
+  scene.world.integrator = Integrator::exact;
+  scene.world.toi = ToiMethod::root;
+  World world(scene);
+  const double e0 = world.total_energy();
+  double worst = 0.0;
+  const long steps = std::lround(600.0 / scene.world.dt);
+  for (long i = 0; i < steps; ++i) {
+    world.step();
+    worst = std::max(worst, std::abs(world.total_energy() / e0 - 1.0));
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(world.total_impacts(), 100u);
+  EXPECT_EQ(world.body(0).activity, Activity::awake);
+  std::cout << "[ measured ] seed/exact 600 s: " << world.total_impacts()
+            << " impacts, worst relative energy error " << worst << "\n";
+}
+
+// The seed itself (midpoint + bisection) still bounces forever and stays above the floor.
+TEST(SeedScene, SeedSettingsRunAndStayAboveTheFloor) {
+  World world(load_scene("seed"));
+  double deepest = 0.0;
+  for (int i = 0; i < 30 * 60; ++i) {
+    world.step();
+    deepest = std::min(deepest, lowest_vertex_y(world.body(0).s, world.body(0).c));
+  }
+  EXPECT_GE(deepest, -1e-9);
+  EXPECT_GT(world.total_impacts(), 10u);
+}
+
+// A box placed on the floor neither sinks, jitters nor drifts, and falls asleep.
+TEST(Rest, RestingBoxesStayPutAndSleep) {
+  World world(load_scene("resting"));
+  std::vector<Vec3> start;
+  for (const Body& b : world.bodies()) start.push_back(b.s.x);
+  for (int i = 0; i < 60 * 60; ++i) world.step();  // one minute
+  for (std::size_t i = 0; i < start.size(); ++i) {
+    const Body& b = world.bodies()[i];
+    EXPECT_EQ(b.activity, Activity::asleep);
+    EXPECT_LT((b.s.x - start[i]).norm(), 1e-12) << i;
+    EXPECT_NEAR(lowest_vertex_y(b.s, b.c), 0.0, 1e-12) << i;
+  }
+  EXPECT_EQ(world.last_step().awake, 0u);
+}
+
+// A tumbling landing with friction ends at rest, asleep, without gaining energy at any step.
+TEST(Friction, ThrownBoxSlidesToRestAndNeverGainsEnergy) {
+  World world(load_scene("friction"));
+  double previous = world.total_energy();
+  double worst_gain = 0.0;
+  int steps = 0;
+  while (world.body(0).activity == Activity::awake && steps < 60 * 30) {
+    world.step();
+    ++steps;
+    worst_gain = std::max(worst_gain, world.total_energy() - previous);
+    previous = world.total_energy();
+  }
+  EXPECT_EQ(world.body(0).activity, Activity::asleep);
+  EXPECT_LT(worst_gain, 1e-9);
+  EXPECT_GE(lowest_vertex_y(world.body(0).s, world.body(0).c), -1e-9);
+  std::cout << "[ measured ] friction: asleep after " << world.time() << " s at x = "
+            << world.body(0).s.x.transpose() << ", worst per-step energy gain " << worst_gain << "\n";
+}
+
+// Coulomb friction on a flat slide: deceleration μ g, stopping distance v² / (2 μ g).
+TEST(Friction, FlatSlideStopsAtCoulombDistance) {
+  Scene scene;
+  scene.world.floor = Floor{0.0, 0.0, 0.4};
+  scene.world.dt = 1.0 / 240.0;
+  BodyDef b;
+  b.position = {0, 0.5, 0};
+  b.velocity = {3, 0, 0};
+  scene.bodies.push_back(b);
+  World world(scene);
+  for (int i = 0; i < 240 * 3; ++i) world.step();
+  const double expected = 9.0 / (2 * 0.4 * kG);
+  // First-order contact stepping: the stop lands within one step's travel.
+  EXPECT_NEAR(world.body(0).s.x.x(), expected, 3.0 / 240.0);
+  EXPECT_NEAR(world.body(0).s.x.y(), 0.5, 1e-9);
+}
+
+}  // namespace
+}  // namespace tumble
