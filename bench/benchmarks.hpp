@@ -1,0 +1,20 @@
+#pragma once
+/// The five questions tumble-bench answers; each writes CSV, plots and its docs section into
+/// Options::out. Single-threaded.
+#include "common.hpp"
+
+namespace tumble_bench {
+
+/// Error against CPU time per integrator and TOI method on `tumble`, `bounce` and `seed`.
+void run_work_precision(const Options& o);
+/// Stress tests with pass criteria (long runs, fast spin, thin plate, rest, Zeno, masses,
+/// one long step).
+void run_stability(const Options& o);
+/// ns per body-step and peak memory for N separated falling boxes.
+void run_throughput(const Options& o);
+/// Cost of 10,000 resting + 10 falling boxes against the 10 alone.
+void run_skip(const Options& o);
+/// The same scenes on Bullet, ODE and MuJoCo, interleaved with Tumble; ratios.
+void run_peers(const Options& o);
+
+}  // namespace tumble_bench

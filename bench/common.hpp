@@ -1,0 +1,99 @@
+#pragma once
+/// Shared plumbing of tumble-bench: options, a progress bar on stderr, CPU timers, memory
+/// readings, CSV files and gnuplot. Not thread-safe (the bench is single-threaded).
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+namespace tumble_bench {
+
+namespace fs = std::filesystem;
+
+/// Command-line options shared by every subcommand.
+struct Options {
+  bool quick = false;  ///< Short version of everything (< 60 s in all), for ctest.
+  fs::path out;        ///< Results directory (CSV, gnuplot scripts, SVG, section markdown).
+  fs::path docs;       ///< Markdown file assembled from the sections.
+  bool plots = true;   ///< Run gnuplot.
+  int repeats = 3;     ///< Interleaved repetitions for timings (median taken).
+};
+
+/// A progress bar on stderr: "label [#####.....]  45%  9/20  3.1 s". Redraws at most 10×/s.
+class Progress {
+ public:
+  Progress(std::string label, std::size_t total);
+  ~Progress();
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+  /// Marks n more units done.
+  void tick(std::size_t n = 1);
+  /// Changes the note printed after the bar ("dt = 1/240").
+  void note(std::string text);
+
+ private:
+  void draw(bool force);
+  std::string label_;
+  std::string note_;
+  std::size_t total_;
+  std::size_t done_ = 0;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_;
+  bool tty_;
+};
+
+/// CPU time of the calling thread, s (immune to other processes taking the core).
+double thread_cpu_seconds();
+/// Wall-clock time, s.
+double wall_seconds();
+/// Resident set size now, bytes (VmRSS), 0 if unknown.
+std::uint64_t resident_bytes();
+/// Peak resident set size since the last reset_peak_resident(), bytes (VmHWM).
+std::uint64_t peak_resident_bytes();
+/// Resets VmHWM (writes 5 to /proc/self/clear_refs); false if the kernel refused.
+bool reset_peak_resident();
+
+/// Median of a non-empty list.
+double median(std::vector<double> v);
+
+/// "1.23e-05"-style formatting with `digits` significant digits.
+std::string fmt(double v, int digits = 3);
+/// Fixed-point formatting.
+std::string fixed(double v, int decimals);
+/// "1/240" when dt is the reciprocal of an integer, else fmt(dt).
+std::string dt_label(double dt);
+
+/// A CSV file with a header line; values written with 17 significant digits.
+class Csv {
+ public:
+  Csv(const fs::path& path, std::initializer_list<std::string> columns);
+  /// Starts a new row.
+  Csv& row();
+  /// Appends one cell to the current row.
+  Csv& operator<<(const std::string& cell);
+  Csv& operator<<(const char* cell);
+  Csv& operator<<(double v);
+  Csv& operator<<(long long v);
+  Csv& operator<<(int v) { return *this << static_cast<long long>(v); }
+  Csv& operator<<(long v) { return *this << static_cast<long long>(v); }
+  Csv& operator<<(std::size_t v) { return *this << static_cast<long long>(v); }
+  ~Csv();
+
+ private:
+  std::ofstream f_;
+  bool first_cell_ = true;
+  bool any_row_ = false;
+};
+
+/// Writes `name`.gp into dir (SVG terminal and output prepended) and runs gnuplot there.
+/// Returns the SVG path (even when gnuplot is missing, so the docs stay stable).
+fs::path plot(const Options& o, const std::string& name, const std::string& script);
+
+/// A Markdown table.
+std::string md_table(const std::vector<std::string>& header,
+                     const std::vector<std::vector<std::string>>& rows);
+
+}  // namespace tumble_bench

@@ -1,0 +1,2 @@
+#include "benchmarks.hpp"
+namespace tumble_bench { void run_peers(const Options&) {} }
