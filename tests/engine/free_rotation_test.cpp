@@ -1,0 +1,306 @@
+// Exact torque-free rotation and the splitting approximation, against closed forms and against
+// the high-accuracy reference integrations in tumble_reference. Measured errors are printed
+// (and recorded as test properties) so they can be quoted.
+#include "free_rotation.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "tumble_reference/free_rigid_body.hpp"
+
+namespace tumble {
+namespace {
+
+using tumble_reference::Method;
+
+// Solid cuboid with full edge lengths (m) and mass (kg): principal moments (kg·m²).
+Vec3 box_inertia(const Vec3& size, double mass) {
+  const Vec3 s2 = size.cwiseProduct(size);
+  return mass / 12.0 * Vec3(s2[1] + s2[2], s2[0] + s2[2], s2[0] + s2[1]);
+}
+
+Mat3 some_rotation(double a, double b, double c) {
+  return (Eigen::AngleAxisd(a, Vec3::UnitZ()) * Eigen::AngleAxisd(b, Vec3::UnitY()) *
+          Eigen::AngleAxisd(c, Vec3::UnitX()))
+      .toRotationMatrix();
+}
+
+double energy(const Vec3& inertia, const Mat3& R, const Vec3& L) {
+  const Vec3 m = R.transpose() * L;
+  return 0.5 * m.cwiseProduct(m).cwiseQuotient(inertia).sum();
+}
+
+// (M² − 2E I_mid) / (2E I_mid): the signed relative distance from the separatrix.
+double separatrix_distance(const Vec3& inertia, const Mat3& R, const Vec3& L) {
+  Vec3 sorted = inertia;
+  std::sort(sorted.data(), sorted.data() + 3);
+  const double two_e_imid = 2.0 * energy(inertia, R, L) * sorted[1];
+  return (L.squaredNorm() - two_e_imid) / two_e_imid;
+}
+
+void report(const std::string& key, double value) {
+  std::printf("  [measured] %-44s %.3e\n", key.c_str(), value);
+  ::testing::Test::RecordProperty(key, std::to_string(value));
+}
+
+// The project's `tumble` case: 1 × 2 × 3 m box, 1 kg, identity start, ω = (0.01, 2, 0.01).
+struct TumbleCase {
+  Vec3 inertia = box_inertia({1.0, 2.0, 3.0}, 1.0);
+  Mat3 R0 = Mat3::Identity();
+  Vec3 L = inertia.cwiseProduct(Vec3(0.01, 2.0, 0.01));
+};
+
+TEST(FreeRotationExact, CubeMatchesClosedForm) {
+  const Vec3 inertia = box_inertia({1.0, 1.0, 1.0}, 2.0);  // I = 1/3 kg·m² on every axis
+  const Mat3 R0 = some_rotation(0.3, -1.1, 2.0);
+  const Vec3 L(0.2, -0.5, 0.35);  // ω = 3 L
+  double worst = 0.0;
+  for (double t : {0.01, 0.5, 1.0, 3.7}) {
+    const Vec3 w = L / inertia[0];
+    const Mat3 expected = Eigen::AngleAxisd(w.norm() * t, w.normalized()).toRotationMatrix() * R0;
+    worst = std::max(worst, rotation_angle_between(expected, free_rotation_exact(inertia, R0, L, t)));
+  }
+  report("cube_vs_closed_form_rad", worst);
+  EXPECT_LT(worst, 1e-14);
+}
+
+TEST(FreeRotationExact, ZeroMomentumOrZeroTimeKeepsAttitude) {
+  const Vec3 inertia(1.0, 2.0, 3.0);
+  const Mat3 R0 = some_rotation(0.1, 0.2, 0.3);
+  EXPECT_EQ(free_rotation_exact(inertia, R0, Vec3::Zero(), 5.0), R0);
+  EXPECT_EQ(free_rotation_exact(inertia, R0, Vec3(1, 2, 3), 0.0), R0);
+}
+
+// Symmetric boxes (prolate 1×1×2 and oblate 2×2×1, and with the distinct axis on x) against
+// the long-double reference over 20 s.
+TEST(FreeRotationExact, SymmetricBoxMatchesReference) {
+  const std::vector<Vec3> sizes{{1.0, 1.0, 2.0}, {2.0, 2.0, 1.0}, {0.5, 1.5, 1.5}};
+  const std::vector<double> times{1.0, 5.0, 12.5, 20.0};
+  double worst = 0.0;
+  for (const Vec3& size : sizes) {
+    const Vec3 inertia = box_inertia(size, 1.5);
+    const Mat3 R0 = some_rotation(0.7, 0.2, -0.4);
+    const Vec3 L(0.4, -0.9, 0.6);
+    const auto ref = tumble_reference::free_rigid_body_attitudes(inertia, R0, L, times,
+                                                                 Method::kMatrixBulirschStoer);
+    for (size_t i = 0; i < times.size(); ++i) {
+      const double e = rotation_angle_between(ref[i], free_rotation_exact(inertia, R0, L, times[i]));
+      worst = std::max(worst, e);
+      EXPECT_LT(e, 1e-11) << "size " << size.transpose() << " t " << times[i];
+    }
+  }
+  report("symmetric_vs_reference_20s_rad", worst);
+}
+
+TEST(FreeRotationReference, TwoMethodsAgreeOnTumble) {
+  const TumbleCase c;
+  std::vector<double> times;
+  for (int i = 1; i <= 20; ++i) times.push_back(i);
+  const auto a = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                             Method::kQuaternionRkf78);
+  const auto b = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                             Method::kMatrixBulirschStoer);
+  double worst = 0.0;
+  for (size_t i = 0; i < times.size(); ++i) worst = std::max(worst, rotation_angle_between(a[i], b[i]));
+  report("tumble_reference_rkf78_vs_bulirsch_stoer_rad", worst);
+  EXPECT_LT(worst, 1e-9);
+}
+
+TEST(FreeRotationExact, TumbleCaseMatchesReference) {
+  const TumbleCase c;
+  const double distance = separatrix_distance(c.inertia, c.R0, c.L);
+  report("tumble_separatrix_distance", distance);
+  EXPECT_GT(distance, 3.0e-6);
+  EXPECT_LT(distance, 4.0e-6);
+
+  // Reference at every 1/30 s frame.
+  const int steps = 600;
+  const double dt = 1.0 / 30.0;
+  std::vector<double> times;
+  for (int i = 1; i <= steps; ++i) times.push_back(i * dt);
+  const auto ref = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                               Method::kMatrixBulirschStoer);
+
+  const Mat3 one_shot = free_rotation_exact(c.inertia, c.R0, c.L, 20.0);
+  const double one_shot_error = rotation_angle_between(ref.back(), one_shot);
+  report("tumble_one_call_20s_vs_reference_rad", one_shot_error);
+  EXPECT_LT(one_shot_error, 1e-8);
+
+  const double e0 = energy(c.inertia, c.R0, c.L);
+  Mat3 R = c.R0;
+  double worst_composed = 0.0, worst_energy = 0.0, worst_orthonormality = 0.0;
+  double worst_direct = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    R = free_rotation_exact(c.inertia, R, c.L, dt);
+    worst_composed = std::max(worst_composed, rotation_angle_between(ref[i], R));
+    worst_energy = std::max(worst_energy, std::abs(energy(c.inertia, R, c.L) / e0 - 1.0));
+    worst_orthonormality = std::max(worst_orthonormality, orthonormality_error(R));
+    if (i % 10 == 9) {  // every 1/3 s, one call from t = 0
+      const Mat3 direct = free_rotation_exact(c.inertia, c.R0, c.L, times[i]);
+      worst_direct = std::max(worst_direct, rotation_angle_between(ref[i], direct));
+    }
+  }
+  report("tumble_600_steps_worst_vs_reference_rad", worst_composed);
+  report("tumble_600_steps_final_vs_reference_rad", rotation_angle_between(ref.back(), R));
+  report("tumble_one_call_any_t_worst_vs_reference_rad", worst_direct);
+  report("tumble_600_steps_energy_relative", worst_energy);
+  report("tumble_600_steps_orthonormality", worst_orthonormality);
+  EXPECT_LT(worst_composed, 1e-8);
+  EXPECT_LT(worst_direct, 1e-8);
+  EXPECT_LT(worst_energy, 1e-13);
+  EXPECT_LT(worst_orthonormality, 1e-13);
+  // |m| = |L|: the body momentum keeps its length (600 composed rotations, no re-projection).
+  const double length_error = std::abs((R.transpose() * c.L).norm() / c.L.norm() - 1.0);
+  report("tumble_600_steps_body_momentum_length_relative", length_error);
+  EXPECT_LT(length_error, 1e-13);
+
+  // The intermediate axis really flips: m_y changes sign within the 20 s.
+  double min_my = 1.0, max_my = -1.0;
+  for (const Mat3& r : ref) {
+    const double my = (r.transpose() * c.L)[1];
+    min_my = std::min(min_my, my);
+    max_my = std::max(max_my, my);
+  }
+  EXPECT_LT(min_my, -1.0);
+  EXPECT_GT(max_my, 1.0);
+}
+
+struct GeneralCase {
+  std::string name;
+  Vec3 inertia;
+  Mat3 R0;
+  Vec3 L;
+};
+
+// Both sides of the separatrix, far from it, and every ordering of the moments over the body
+// axes; 20 s against the long-double reference.
+std::vector<GeneralCase> general_cases() {
+  const Vec3 box = box_inertia({1.0, 2.0, 3.0}, 1.0);
+  std::vector<GeneralCase> cases;
+  // Other side: ω_z a little larger makes M² < 2E I_mid (about −4e-6 from the separatrix).
+  cases.push_back({"tumble_other_side", box, Mat3::Identity(),
+                   box.cwiseProduct(Vec3(0.01, 2.0, 0.015))});
+  cases.push_back({"far_major_axis", box, some_rotation(0.4, 1.0, -0.3),
+                   Vec3(0.3, -0.2, 0.9)});
+  cases.push_back({"far_minor_axis", box, some_rotation(-1.2, 0.5, 2.1),
+                   some_rotation(-1.2, 0.5, 2.1) * box.cwiseProduct(Vec3(0.3, 0.4, 2.5))});
+  const std::array<std::array<int, 3>, 6> perms{
+      {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
+  for (const auto& p : perms) {
+    const Vec3 inertia(0.7 + p[0], 0.7 + 1.3 * p[1], 0.7 + 1.3 * p[2]);
+    cases.push_back({"permuted_" + std::to_string(p[0]) + std::to_string(p[1]) +
+                         std::to_string(p[2]),
+                     inertia, some_rotation(0.3 * p[0], 1.0 - p[1], 0.5 * p[2]),
+                     Vec3(-0.8, 1.1, 0.45)});
+  }
+  return cases;
+}
+
+TEST(FreeRotationExact, GeneralCasesMatchReference) {
+  const std::vector<double> times{0.25, 3.0, 7.3, 20.0};
+  for (const GeneralCase& c : general_cases()) {
+    const auto ref = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                                 Method::kMatrixBulirschStoer);
+    const double e0 = energy(c.inertia, c.R0, c.L);
+    double worst = 0.0, worst_energy = 0.0;
+    for (size_t i = 0; i < times.size(); ++i) {
+      const Mat3 R = free_rotation_exact(c.inertia, c.R0, c.L, times[i]);
+      worst = std::max(worst, rotation_angle_between(ref[i], R));
+      worst_energy = std::max(worst_energy, std::abs(energy(c.inertia, R, c.L) / e0 - 1.0));
+    }
+    std::printf("  %-20s separatrix distance % .3e\n", c.name.c_str(),
+                separatrix_distance(c.inertia, c.R0, c.L));
+    report(c.name + "_vs_reference_rad", worst);
+    report(c.name + "_energy_relative", worst_energy);
+    EXPECT_LT(worst, c.name == "tumble_other_side" ? 1e-8 : 1e-11) << c.name;
+    EXPECT_LT(worst_energy, 1e-13) << c.name;
+  }
+}
+
+// Exactly on the separatrix (k = 1, the sech/tanh limit): inertia (1, 4, 16) and m = (1, ·, 2)
+// make M² − 2E I_mid vanish in floating point. The motion is unstable there (round-off grows
+// like e^{λt}), so the comparison is over a few seconds only.
+TEST(FreeRotationExact, ExactlyOnSeparatrix) {
+  const Vec3 inertia(1.0, 4.0, 16.0);
+  for (double sign : {1.0, -1.0}) {
+    const Vec3 L(sign * 1.0, 0.7, -2.0);  // R0 = I, so m = L
+    const std::vector<double> times{0.5, 2.0, 4.0};
+    const auto ref = tumble_reference::free_rigid_body_attitudes(
+        inertia, Mat3::Identity(), L, times, Method::kMatrixBulirschStoer);
+    double worst = 0.0;
+    for (size_t i = 0; i < times.size(); ++i) {
+      worst = std::max(worst, rotation_angle_between(
+                                  ref[i], free_rotation_exact(inertia, Mat3::Identity(), L, times[i])));
+    }
+    report(sign > 0 ? "on_separatrix_vs_reference_rad" : "on_separatrix_m1_negative_rad", worst);
+    EXPECT_LT(worst, 1e-10);
+  }
+}
+
+// Steady spins about each principal axis are plain rotations about that axis.
+TEST(FreeRotationExact, SteadySpinAboutPrincipalAxes) {
+  const Vec3 inertia(2.0, 1.0, 3.0);
+  const Mat3 R0 = some_rotation(0.5, -0.3, 1.2);
+  for (int axis = 0; axis < 3; ++axis) {
+    const Vec3 m = -1.7 * Vec3::Unit(axis);
+    const double t = 2.3;
+    const Mat3 expected = R0 * axis_rotation(axis, t * m[axis] / inertia[axis]);
+    const Mat3 got = free_rotation_exact(inertia, R0, R0 * m, t);
+    EXPECT_LT(rotation_angle_between(expected, got), 1e-14) << "axis " << axis;
+  }
+}
+
+// Splitting: second order, so halving h divides the error by ~4; |m| and orthonormality to
+// round-off whatever h.
+double splitting_error(const Vec3& inertia, const Mat3& R0, const Vec3& L, double T, int n) {
+  Mat3 R = R0;
+  for (int i = 0; i < n; ++i) R = free_rotation_splitting(inertia, R, L, T / n);
+  return rotation_angle_between(free_rotation_exact(inertia, R0, L, T), R);
+}
+
+TEST(FreeRotationSplitting, IsSecondOrder) {
+  for (const GeneralCase& c : general_cases()) {
+    if (c.name.rfind("far", 0) != 0) continue;
+    const double e1 = splitting_error(c.inertia, c.R0, c.L, 2.0, 200);
+    const double e2 = splitting_error(c.inertia, c.R0, c.L, 2.0, 400);
+    const double e3 = splitting_error(c.inertia, c.R0, c.L, 2.0, 800);
+    report(c.name + "_splitting_h0.01_rad", e1);
+    report(c.name + "_splitting_ratio_h/h2", e1 / e2);
+    report(c.name + "_splitting_ratio_h2/h4", e2 / e3);
+    EXPECT_NEAR(e1 / e2, 4.0, 0.3) << c.name;
+    EXPECT_NEAR(e2 / e3, 4.0, 0.3) << c.name;
+  }
+}
+
+TEST(FreeRotationSplitting, TumbleCaseAccuracyAndInvariants) {
+  const TumbleCase c;
+  Mat3 R = c.R0;
+  const double e0 = energy(c.inertia, c.R0, c.L);
+  double worst_energy = 0.0;
+  for (int i = 0; i < 600; ++i) {
+    R = free_rotation_splitting(c.inertia, R, c.L, 1.0 / 30.0);
+    worst_energy = std::max(worst_energy, std::abs(energy(c.inertia, R, c.L) / e0 - 1.0));
+  }
+  const double error = rotation_angle_between(free_rotation_exact(c.inertia, c.R0, c.L, 20.0), R);
+  report("tumble_splitting_600_steps_vs_exact_rad", error);
+  report("tumble_splitting_energy_relative", worst_energy);
+  EXPECT_NEAR((R.transpose() * c.L).norm() / c.L.norm(), 1.0, 1e-14);
+  EXPECT_LT(orthonormality_error(R), 1e-13);
+  // Energy error of a symplectic splitting stays bounded (O(h²)), it does not drift.
+  EXPECT_LT(worst_energy, 1e-3);
+  // Second order at h = 1/30 s near the separatrix: a visible but bounded attitude error.
+  EXPECT_LT(error, 0.5);
+  const double e1 = splitting_error(c.inertia, c.R0, c.L, 2.0, 200);
+  const double e2 = splitting_error(c.inertia, c.R0, c.L, 2.0, 400);
+  report("tumble_splitting_ratio_h/h2_over_2s", e1 / e2);
+  EXPECT_NEAR(e1 / e2, 4.0, 0.4);
+}
+
+}  // namespace
+}  // namespace tumble
