@@ -1,0 +1,48 @@
+#pragma once
+/// Counters and gauges for GET /metrics (Prometheus text format). Thread-safe: every field is
+/// an atomic written by one kind of thread (the simulation thread or the I/O threads).
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <string>
+
+namespace tumble::server {
+
+struct Snapshot;
+
+/// Server-wide metrics.
+class Metrics {
+ public:
+  /// Upper bounds of the step-time histogram buckets, seconds (then +Inf).
+  static constexpr std::array<double, 10> kStepBuckets{1e-6, 1e-5, 5e-5, 1e-4, 5e-4,
+                                                       1e-3, 5e-3, 1e-2, 5e-2, 1e-1};
+
+  /// Records the wall time of one World::step, seconds (simulation thread).
+  void observe_step(double seconds);
+  /// Adds simulated seconds dropped because the loop fell behind (simulation thread).
+  void add_dropped_time(double seconds);
+  /// A frame was handed to a session's writer.
+  void count_frame_sent() { frames_sent_.fetch_add(1, std::memory_order_relaxed); }
+  /// A queued frame was replaced by a newer one before it could be written.
+  void count_frame_dropped() { frames_dropped_.fetch_add(1, std::memory_order_relaxed); }
+  /// Frames sent so far (all sessions).
+  std::uint64_t frames_sent() const { return frames_sent_.load(std::memory_order_relaxed); }
+  /// Frames dropped so far (all sessions).
+  std::uint64_t frames_dropped() const { return frames_dropped_.load(std::memory_order_relaxed); }
+  /// A request was answered with `status`.
+  void count_http(unsigned status);
+
+  /// The Prometheus text exposition, with gauges read from `latest` and `viewers`.
+  std::string render(const Snapshot& latest, std::size_t viewers) const;
+
+ private:
+  std::array<std::atomic<std::uint64_t>, kStepBuckets.size() + 1> step_buckets_{};
+  std::atomic<std::uint64_t> step_count_{0};
+  std::atomic<double> step_seconds_sum_{0.0};
+  std::atomic<double> dropped_time_{0.0};
+  std::atomic<std::uint64_t> frames_sent_{0};
+  std::atomic<std::uint64_t> frames_dropped_{0};
+  std::array<std::atomic<std::uint64_t>, 6> http_by_class_{};  // 0xx..5xx
+};
+
+}  // namespace tumble::server

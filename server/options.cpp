@@ -1,0 +1,99 @@
+#include "options.hpp"
+
+#include <boost/asio/ip/address.hpp>
+#include <boost/program_options.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <sstream>
+
+namespace po = boost::program_options;
+
+namespace tumble::server {
+namespace {
+
+po::options_description describe() {
+  po::options_description d("tumble-server options (each also from env TUMBLE_<NAME>, e.g. "
+                            "TUMBLE_PORT; the command line wins)");
+  d.add_options()
+      ("help,h", "print this help and exit")
+      ("scene", po::value<std::string>()->default_value("seed"),
+       "bundled scene name or path to a scene JSON file")
+      ("port", po::value<int>()->default_value(8080), "TCP port (0: any free port)")
+      ("bind", po::value<std::string>()->default_value("127.0.0.1"), "address to listen on")
+      ("render-ms", po::value<int>()->default_value(20), "WebSocket frame interval, ms (1-1000)")
+      ("web-root", po::value<std::string>()->default_value(default_web_root().string()),
+       "directory of the viewer's static files")
+      ("threads", po::value<int>()->default_value(2), "I/O threads (1-64)")
+      ("token", po::value<std::string>()->default_value(""),
+       "bearer token required on POST requests (empty: none)")
+      ("max-viewers", po::value<int>()->default_value(64), "most WebSocket viewers (1-10000)")
+      ("allowed-origin", po::value<std::string>()->default_value(""),
+       "browser Origin allowed besides the server's own ('*': any)");
+  return d;
+}
+
+std::string usage(const po::options_description& d) {
+  std::ostringstream out;
+  out << "Usage: tumble-server [options]\n" << d;
+  return out.str();
+}
+
+std::string env_to_option(const po::options_description& d, const std::string& env) {
+  constexpr std::string_view kPrefix = "TUMBLE_";
+  if (env.rfind(kPrefix, 0) != 0) return {};
+  std::string name = env.substr(kPrefix.size());
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) {
+    return c == '_' ? '-' : static_cast<char>(std::tolower(c));
+  });
+  if (name == "help" || !d.find_nothrow(name, false)) return {};
+  return name;
+}
+
+ParsedOptions bad(std::string message, const po::options_description& d) {
+  return {std::nullopt, 2, "tumble-server: " + message + "\n\n" + usage(d)};
+}
+
+}  // namespace
+
+std::filesystem::path default_web_root() { return TUMBLE_SOURCE_WEB_ROOT; }
+
+ParsedOptions parse_options(int argc, const char* const argv[]) {
+  const po::options_description d = describe();
+  po::variables_map vm;
+  try {
+    // The first store of a value wins: the command line, then the environment.
+    po::store(po::parse_command_line(argc, argv, d), vm);
+    po::store(po::parse_environment(
+                  d, [&d](const std::string& env) { return env_to_option(d, env); }),
+              vm);
+    po::notify(vm);
+  } catch (const std::exception& e) {
+    return bad(e.what(), d);
+  }
+  if (vm.count("help")) return {std::nullopt, 0, usage(d)};
+
+  ServerOptions o;
+  o.scene = vm["scene"].as<std::string>();
+  const int port = vm["port"].as<int>();
+  if (port < 0 || port > 65535) return bad("--port must be in 0..65535", d);
+  o.port = static_cast<std::uint16_t>(port);
+  o.bind = vm["bind"].as<std::string>();
+  boost::system::error_code ec;
+  boost::asio::ip::make_address(o.bind, ec);
+  if (ec) return bad("--bind is not an IP address: " + o.bind, d);
+  o.render_ms = vm["render-ms"].as<int>();
+  if (o.render_ms < 1 || o.render_ms > 1000) return bad("--render-ms must be in 1..1000", d);
+  o.web_root = vm["web-root"].as<std::string>();
+  o.threads = vm["threads"].as<int>();
+  if (o.threads < 1 || o.threads > 64) return bad("--threads must be in 1..64", d);
+  o.token = vm["token"].as<std::string>();
+  o.max_viewers = vm["max-viewers"].as<int>();
+  if (o.max_viewers < 1 || o.max_viewers > 10000)
+    return bad("--max-viewers must be in 1..10000", d);
+  o.allowed_origin = vm["allowed-origin"].as<std::string>();
+  if (o.scene.empty()) return bad("--scene must not be empty", d);
+  return {o, 0, {}};
+}
+
+}  // namespace tumble::server

@@ -1,0 +1,37 @@
+#pragma once
+/// Command-line and environment configuration of tumble-server.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace tumble::server {
+
+/// Everything the server is configured with. Plain data.
+struct ServerOptions {
+  std::string scene = "seed";          ///< Bundled scene name or a path to a scene file.
+  std::uint16_t port = 8080;           ///< TCP port; 0 picks a free one.
+  std::string bind = "127.0.0.1";      ///< Address to listen on.
+  int render_ms = 20;                  ///< Interval between WebSocket frames, ms.
+  std::filesystem::path web_root;      ///< Directory of the viewer's static files.
+  int threads = 2;                     ///< I/O threads (the simulation has its own).
+  std::string token;                   ///< Bearer token for POSTs; empty: none required.
+  int max_viewers = 64;                ///< Most WebSocket viewers at once.
+  std::string allowed_origin;          ///< Origin allowed besides the server's own; "*": any.
+};
+
+/// Result of parsing: options, or an exit code with the text to print.
+struct ParsedOptions {
+  std::optional<ServerOptions> options;  ///< Set when the server should start.
+  int exit_code = 0;                     ///< 0 after --help, 2 for bad input.
+  std::string message;                   ///< Usage or error text.
+};
+
+/// The source tree's web/ directory (the default --web-root).
+std::filesystem::path default_web_root();
+
+/// Parses argv, then the TUMBLE_* environment (TUMBLE_PORT → --port …); the command line wins.
+/// Never throws.
+ParsedOptions parse_options(int argc, const char* const argv[]);
+
+}  // namespace tumble::server

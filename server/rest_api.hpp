@@ -1,0 +1,33 @@
+#pragma once
+/// The REST routes of docs/protocol.md (/api/…, /metrics): parse and validate at the
+/// boundary, then answer from the latest snapshot or through a command to the simulation.
+/// Never throws.
+#include <functional>
+#include <string_view>
+
+#include <boost/beast/http.hpp>
+
+#include "context.hpp"
+
+namespace tumble::server {
+
+using Request = boost::beast::http::request<boost::beast::http::string_body>;
+using Response = boost::beast::http::response<boost::beast::http::string_body>;
+/// Receives the response, once; may be called on the simulation thread.
+using Reply = std::function<void(Response)>;
+
+/// True for targets the API owns (/api, /api/…, /metrics).
+bool is_api_target(std::string_view path);
+
+/// True when a browser request's Origin may act on this server: no Origin header (not a
+/// browser), the server's own origin (http://<Host>), or --allowed-origin ("*": any).
+bool origin_allowed(const Request& request, const ServerOptions& options);
+
+/// A JSON response {"error": message, "field": field}.
+Response error_response(const Request& request, unsigned status, std::string_view message,
+                        std::string_view field);
+
+/// Handles an API request; `reply` gets the response (at once or when the command is done).
+void handle_api(const Request& request, ServerContext& ctx, Reply reply);
+
+}  // namespace tumble::server

@@ -1,0 +1,76 @@
+#include "server.hpp"
+
+#include <boost/asio/ip/address.hpp>
+#include <boost/asio/post.hpp>
+
+#include <cstdio>
+
+#include "listener.hpp"
+
+namespace tumble::server {
+
+namespace net = boost::asio;
+
+namespace {
+
+std::filesystem::path canonical_root(const std::filesystem::path& root) {
+  std::error_code ec;
+  std::filesystem::path p = std::filesystem::canonical(root, ec);
+  if (ec) {
+    std::fprintf(stderr, "tumble-server: warning: web root %s: %s (static files will 404)\n",
+                 root.string().c_str(), ec.message().c_str());
+    return std::filesystem::absolute(root, ec);
+  }
+  return p;
+}
+
+}  // namespace
+
+Server::Server(ServerOptions options, Scene scene)
+    : options_(std::move(options)),
+      sim_(std::move(scene), metrics_),
+      ioc_(options_.threads),
+      broadcaster_(ioc_, sim_, std::chrono::milliseconds(options_.render_ms),
+                   static_cast<std::size_t>(options_.max_viewers)),
+      ctx_{options_, canonical_root(options_.web_root), sim_, broadcaster_, metrics_} {}
+
+Server::~Server() { stop(); }
+
+void Server::start() {
+  const net::ip::tcp::endpoint endpoint(net::ip::make_address(options_.bind), options_.port);
+  listener_ = std::make_shared<Listener>(ioc_, endpoint, ctx_);
+  work_.emplace(ioc_.get_executor());
+  listener_->run();
+  broadcaster_.start();
+  sim_.start();
+  for (int i = 0; i < options_.threads; ++i) threads_.emplace_back([this] { ioc_.run(); });
+}
+
+void Server::stop() {
+  if (stopped_.exchange(true)) return;
+  if (listener_) {
+    listener_->stop();
+    broadcaster_.stop();
+    broadcaster_.close_all();
+    // Viewers answer the close frame; give them a moment, then cut what is left.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+    while (broadcaster_.viewers() > 0 && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  sim_.stop();
+  work_.reset();
+  ioc_.stop();
+  for (std::thread& t : threads_) t.join();
+  threads_.clear();
+}
+
+std::uint16_t Server::port() const { return listener_ ? listener_->port() : 0; }
+
+std::string Server::url() const {
+  const net::ip::address address = net::ip::make_address(options_.bind);
+  std::string host = address.is_unspecified() ? std::string("127.0.0.1") : options_.bind;
+  if (address.is_v6() && !address.is_unspecified()) host = "[" + host + "]";
+  return "http://" + host + ":" + std::to_string(port()) + "/";
+}
+
+}  // namespace tumble::server

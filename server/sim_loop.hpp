@@ -1,0 +1,85 @@
+#pragma once
+/// The simulation thread: it alone owns the tumble::World. It runs a fixed-step real-time
+/// loop, runs the commands of I/O threads before each step and publishes an immutable
+/// Snapshot after every step and every command.
+///
+/// Usage:
+///   SimLoop sim(tumble::load_scene("seed"), metrics);
+///   sim.start();
+///   sim.submit({PauseCommand{}, [](CommandResult r) { … }});
+///   auto snap = sim.latest();   // any thread
+///   sim.stop();
+#include <atomic>
+#include <deque>
+#include <memory>
+#include <thread>
+#include <utility>
+
+#include "commands.hpp"
+#include "metrics.hpp"
+#include "snapshot.hpp"
+#include "tumble/world.hpp"
+
+namespace tumble::server {
+
+/// The real-time loop around one World. Public members are thread-safe.
+class SimLoop {
+ public:
+  /// Most simulated time (s) the loop catches up in one go; beyond that it drops time and
+  /// the real-time factor falls below 1 instead of spiralling.
+  static constexpr double kMaxCatchUp = 0.1;
+  /// Wall-time window (s) over which the real-time factor is measured.
+  static constexpr double kRtfWindow = 2.0;
+  /// Shortest window (s) that updates it; until then (after a start, resume or reset) the
+  /// last value stands (1 at start).
+  static constexpr double kRtfMinWindow = 0.05;
+
+  /// Builds the world (throws tumble::InvalidInput for an invalid scene) and publishes its
+  /// first snapshot. The loop does not run until start().
+  SimLoop(Scene scene, Metrics& metrics);
+  /// Stops the thread.
+  ~SimLoop();
+  SimLoop(const SimLoop&) = delete;
+  SimLoop& operator=(const SimLoop&) = delete;
+
+  /// Starts the simulation thread.
+  void start();
+  /// Stops and joins it; queued and later commands complete with 503. Idempotent.
+  void stop();
+  /// Queues a command; its completion runs on the simulation thread.
+  void submit(Command command) { queue_.push(std::move(command)); }
+  /// The latest published snapshot (never null).
+  std::shared_ptr<const Snapshot> latest() const { return latest_.load(); }
+
+ private:
+  enum class Change { step, command, restart };
+
+  void run();
+  void advance();
+  void step_once();
+  void execute(Command& command);
+  CommandResult run_command(CommandKind& kind);
+  CommandResult reset(ResetCommand& c);
+  CommandResult step_paused(const StepCommand& c);
+  CommandResult impulse(const ImpulseCommand& c);
+  void anchor(Clock::time_point now);
+  double sim_clock(Clock::time_point now) const;
+  void publish(Change change);
+  void new_scene_info();
+
+  Metrics& metrics_;
+  std::unique_ptr<World> world_;
+  std::shared_ptr<const SceneInfo> scene_info_;
+  std::uint64_t generation_ = 0;
+  bool paused_ = false;
+  // The running real-time clock: sim_clock(w) = anchor_sim_ + (w − anchor_wall_).
+  Clock::time_point anchor_wall_{};
+  double anchor_sim_ = 0.0;
+  std::deque<std::pair<Clock::time_point, double>> rtf_samples_;  // (wall, sim time)
+  double real_time_factor_ = 1.0;
+  CommandQueue queue_;
+  std::atomic<std::shared_ptr<const Snapshot>> latest_;
+  std::thread thread_;
+};
+
+}  // namespace tumble::server

@@ -1,0 +1,96 @@
+#include "static_files.hpp"
+
+#include <algorithm>
+#include <optional>
+#include <string>
+
+namespace tumble::server {
+namespace {
+
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+std::optional<std::string> percent_decode(std::string_view in) {
+  std::string out;
+  out.reserve(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (in[i] != '%') {
+      out.push_back(in[i]);
+      continue;
+    }
+    if (i + 2 >= in.size()) return std::nullopt;
+    const int hi = hex_value(in[i + 1]);
+    const int lo = hex_value(in[i + 2]);
+    if (hi < 0 || lo < 0) return std::nullopt;
+    out.push_back(static_cast<char>(hi * 16 + lo));
+    i += 2;
+  }
+  return out;
+}
+
+bool inside(const std::filesystem::path& root, const std::filesystem::path& p) {
+  auto r = root.begin();
+  auto q = p.begin();
+  for (; r != root.end(); ++r, ++q)
+    if (q == p.end() || *r != *q) return false;
+  return true;
+}
+
+}  // namespace
+
+StaticLookup resolve_static(const std::filesystem::path& root, std::string_view target) {
+  namespace fs = std::filesystem;
+  target = target.substr(0, target.find_first_of("?#"));
+  if (target.empty() || target.front() != '/') return {400, {}};
+  const std::optional<std::string> decoded = percent_decode(target);
+  if (!decoded) return {400, {}};
+  std::string path = *decoded;
+  if (path.find('\0') != std::string::npos || path.find('\\') != std::string::npos)
+    return {403, {}};
+  if (path.back() == '/') path += "index.html";
+
+  // Every segment must be a plain name: no "..", ".", or empty segments ("//").
+  fs::path relative;
+  std::size_t start = 1;
+  while (start <= path.size()) {
+    const std::size_t end = std::min(path.find('/', start), path.size());
+    const std::string_view segment(path.data() + start, end - start);
+    if (segment.empty() || segment == "." || segment == "..") return {403, {}};
+    relative /= fs::path(std::string(segment));
+    start = end + 1;
+  }
+
+  std::error_code ec;
+  const fs::path resolved = fs::canonical(root / relative, ec);  // Follows symlinks.
+  if (ec) return {404, {}};
+  if (!inside(root, resolved)) return {403, {}};
+  if (!fs::is_regular_file(resolved, ec)) return {404, {}};
+  return {200, resolved};
+}
+
+std::string_view mime_type(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".html" || ext == ".htm") return "text/html; charset=utf-8";
+  if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
+  if (ext == ".css") return "text/css; charset=utf-8";
+  if (ext == ".json" || ext == ".map") return "application/json";
+  if (ext == ".svg") return "image/svg+xml";
+  if (ext == ".png") return "image/png";
+  if (ext == ".jpg" || ext == ".jpeg") return "image/jpeg";
+  if (ext == ".gif") return "image/gif";
+  if (ext == ".ico") return "image/vnd.microsoft.icon";
+  if (ext == ".wasm") return "application/wasm";
+  if (ext == ".txt" || ext == ".md") return "text/plain; charset=utf-8";
+  if (ext == ".woff2") return "font/woff2";
+  if (ext == ".glb") return "model/gltf-binary";
+  if (ext == ".gltf") return "model/gltf+json";
+  return "application/octet-stream";
+}
+
+}  // namespace tumble::server
