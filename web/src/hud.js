@@ -1,0 +1,148 @@
+// Heads-up display: connection state, sim time, real-time factor, frame rates, dropped frames,
+// body activity counts, and short error toasts. Also keeps the statistics it shows.
+import { Activity } from './protocol.js';
+
+/** Wall-clock window over which rates are measured, ms. */
+const kRateWindowMs = 1000;
+/** HUD text refresh interval, ms. */
+const kRefreshMs = 200;
+
+const kStateText = { connecting: 'connecting…', open: 'live', reconnecting: 'reconnecting…' };
+
+export class Hud {
+  /** @param {HTMLElement} root element holding the `[data-field]` spans */
+  constructor(root, toastBox) {
+    this.root = root;
+    this.toastBox = toastBox;
+    this.fields = {}; // field name → elements showing it
+    for (const el of root.querySelectorAll('[data-field]')) (this.fields[el.dataset.field] ??= []).push(el);
+    this.connection = 'connecting';
+    this.retryInMs = 0;
+    this.sceneName = '';
+    this.integrator = '';
+    this.simTime = 0;
+    this.paused = false;
+    this.framesReceived = 0;   // binary frames received since the page loaded
+    this.dropped = 0;          // frames the server sent that never reached us (frame-number gaps)
+    this.lastFrameNumber = null;
+    this.counts = { awake: 0, asleep: 0, frozen: 0 };
+    this.frameSamples = [];    // [wall ms, sim time s] of recent frames
+    this.renderTimes = [];     // wall ms of recent animation frames
+    this.lastRefresh = 0;
+  }
+
+  setConnection(state, detail = {}) {
+    this.connection = state;
+    this.retryInMs = detail.retryInMs ?? 0;
+    if (state === 'open') {
+      // A new connection may be a restarted server whose frame counter starts again.
+      this.lastFrameNumber = null;
+      this.frameSamples.length = 0;
+    }
+    this.refresh(performance.now(), true);
+  }
+
+  setScene(name, integrator) {
+    this.sceneName = name;
+    if (integrator) this.integrator = integrator;
+    this.frameSamples.length = 0;
+  }
+
+  setIntegrator(name) {
+    this.integrator = name;
+  }
+
+  /** Records a decoded frame received at wall time `now` (ms). */
+  onFrame(frame, now) {
+    this.framesReceived += 1;
+    if (this.lastFrameNumber !== null) {
+      const gap = (frame.frame - this.lastFrameNumber - 1) >>> 0; // u32 wrap-around safe
+      if (gap > 0 && gap < 1e6) this.dropped += gap;
+    }
+    this.lastFrameNumber = frame.frame;
+    if (frame.time < this.simTime) this.frameSamples.length = 0;
+    this.simTime = frame.time;
+    this.paused = frame.paused;
+    let asleep = 0, frozen = 0;
+    for (let i = 0; i < frame.count; i++) {
+      if (frame.activity[i] === Activity.asleep) asleep++;
+      else if (frame.activity[i] === Activity.frozen) frozen++;
+    }
+    this.counts = { awake: frame.count - asleep - frozen, asleep, frozen };
+    this.frameSamples.push([now, frame.time]);
+    trim(this.frameSamples, now, (s) => s[0]);
+  }
+
+  /** Records an animation frame at wall time `now` (ms) and refreshes the text now and then. */
+  onRender(now) {
+    this.renderTimes.push(now);
+    trim(this.renderTimes, now, (t) => t);
+    this.refresh(now, false);
+  }
+
+  /** Frames per second drawn by the page. */
+  get renderFps() {
+    return rate(this.renderTimes.length, this.renderTimes[0], this.renderTimes[this.renderTimes.length - 1]);
+  }
+
+  /** Frames per second received from the server. */
+  get streamFps() {
+    const s = this.frameSamples;
+    return s.length ? rate(s.length, s[0][0], s[s.length - 1][0]) : 0;
+  }
+
+  /** Sim seconds per wall second over the last second of frames (0 while paused). */
+  get realTimeFactor() {
+    const s = this.frameSamples;
+    if (s.length < 2 || this.paused) return 0;
+    const wall = (s[s.length - 1][0] - s[0][0]) / 1000;
+    return wall > 0 ? (s[s.length - 1][1] - s[0][1]) / wall : 0;
+  }
+
+  refresh(now, force) {
+    if (!force && now - this.lastRefresh < kRefreshMs) return;
+    this.lastRefresh = now;
+    const f = this.fields;
+    const live = this.connection === 'open';
+    let connText = kStateText[this.connection] ?? this.connection;
+    if (this.connection === 'reconnecting' && this.retryInMs) connText += ` (retry in ${(this.retryInMs / 1000).toFixed(1)} s)`;
+    this.root.dataset.connection = this.connection;
+    set(f.connection, connText);
+    set(f.scene, this.sceneName || '—');
+    set(f.integrator, this.integrator || '—');
+    set(f.time, `${this.simTime.toFixed(3)} s`);
+    set(f.paused, this.paused ? 'paused' : 'running');
+    this.root.dataset.paused = String(this.paused);
+    set(f.rtf, live && !this.paused ? `${this.realTimeFactor.toFixed(2)}×` : '—');
+    set(f.fps, `${this.renderFps.toFixed(0)}`);
+    set(f.stream, live ? `${this.streamFps.toFixed(0)}` : '0');
+    set(f.dropped, String(this.dropped));
+    const c = this.counts;
+    set(f.bodies, `${c.awake + c.asleep + c.frozen}`);
+    set(f.activity, `${c.awake} awake · ${c.asleep} asleep${c.frozen ? ` · ${c.frozen} frozen` : ''}`);
+    this.root.dataset.frozen = String(c.frozen > 0);
+  }
+
+  /** Shows a short message at the bottom of the screen for a few seconds. */
+  toast(message, kind = 'error') {
+    const el = document.createElement('div');
+    el.className = `toast ${kind}`;
+    el.textContent = message;
+    this.toastBox.appendChild(el);
+    setTimeout(() => el.remove(), 4000);
+  }
+}
+
+function set(elements, text) {
+  for (const el of elements ?? []) if (el.textContent !== text) el.textContent = text;
+}
+
+function trim(list, now, wallOf) {
+  let drop = 0;
+  while (drop < list.length - 1 && now - wallOf(list[drop]) > kRateWindowMs) drop++;
+  if (drop) list.splice(0, drop);
+}
+
+function rate(count, first, last) {
+  return count >= 2 && last > first ? ((count - 1) * 1000) / (last - first) : 0;
+}

@@ -1,0 +1,390 @@
+// The three.js scene: boxes rebuilt from every frame's vertices, lights, shadows, floor, camera,
+// orbit controls and picking. Knows nothing of the network.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { Activity, sceneFloor } from './protocol.js';
+
+const kBackground = 0x16191f;
+const kFrozenTint = new THREE.Color(0xff4d4d);
+const kEdgeColor = new THREE.Color(0x0b0d10);
+const kFrozenEdgeColor = new THREE.Color(0xff3030);
+const kMaxShadowExtent = 60; // m: beyond this the shadow map would be too coarse to be useful.
+const kMaxLabels = 16;
+const kKickMs = 700; // lifetime of the kick arrow
+
+// The 12 box edges as vertex-index pairs (vertex i: bit 0 → +x, bit 1 → +y, bit 2 → +z).
+const kEdges = [[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7], [0, 4], [1, 5], [2, 6], [3, 7]];
+
+const kFloorSize = 400;     // m, edge of the square floor
+const kGridTileMetres = 5; // one texture tile: 5 × 5 one-metre cells
+
+/** A 5 m × 5 m floor tile: a line every metre, a stronger one on the tile's edge. */
+function drawGridTile() {
+  const px = 320, cell = px / kGridTileMetres;
+  const canvas = document.createElement('canvas');
+  canvas.width = canvas.height = px;
+  const g = canvas.getContext('2d');
+  g.fillStyle = '#2b3039';
+  g.fillRect(0, 0, px, px);
+  g.fillStyle = '#394050';
+  for (let i = 1; i < kGridTileMetres; i++) {
+    g.fillRect(i * cell - 1, 0, 2, px);
+    g.fillRect(0, i * cell - 1, px, 2);
+  }
+  g.fillStyle = '#4a5366';
+  g.fillRect(0, 0, 3, px);
+  g.fillRect(0, 0, px, 3);
+  return canvas;
+}
+
+/** Colour of a body for its activity: asleep ones desaturated, frozen ones tinted red. */
+function displayColor(base, activity, out) {
+  out.copy(base);
+  if (activity === Activity.asleep) {
+    const hsl = {};
+    out.getHSL(hsl, THREE.SRGBColorSpace); // perceptual HSL, so the hue stays put
+    out.setHSL(hsl.h, hsl.s * 0.5, hsl.l * 0.9, THREE.SRGBColorSpace);
+  } else if (activity === Activity.frozen) {
+    out.lerp(kFrozenTint, 0.45);
+  }
+  return out;
+}
+
+export class Viewer {
+  /** @param {HTMLElement} container the element the canvas fills. */
+  constructor(container) {
+    this.container = container;
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, powerPreference: 'high-performance' });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.renderer.shadowMap.enabled = true;
+    this.renderer.shadowMap.type = THREE.PCFShadowMap;
+    container.appendChild(this.renderer.domElement);
+
+    this.scene = new THREE.Scene();
+    this.scene.background = new THREE.Color(kBackground);
+    this.scene.fog = new THREE.Fog(kBackground, 40, 120);
+
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.05, 2000);
+    this.camera.position.set(6, 4.5, 8);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.enableDamping = true;
+    this.controls.dampingFactor = 0.08;
+    this.controls.target.set(0, 1, 0);
+
+    this.#addLights();
+    this.floor = this.#makeFloor();
+    this.scene.add(this.floor);
+
+    this.boxes = null;  // THREE.Mesh of all boxes (one draw call)
+    this.edges = null;  // THREE.LineSegments of all box edges
+    this.bodyCount = 0;
+    this.faces = [];
+    this.baseColors = [];
+    this.activity = new Uint8Array(0);
+    this.hasPose = false;
+    this.needsFit = true;
+    this.framesSinceShadowFit = 0;
+    this.labels = this.#makeLabels();
+    this.raycaster = new THREE.Raycaster();
+    this.kicks = [];
+
+    window.addEventListener('resize', () => this.resize());
+    this.resize();
+  }
+
+  #addLights() {
+    this.scene.add(new THREE.HemisphereLight(0xdfe8ff, 0x40362e, 1.1));
+    const sun = new THREE.DirectionalLight(0xfff6ea, 2.8);
+    sun.castShadow = true;
+    sun.shadow.mapSize.set(2048, 2048);
+    sun.shadow.radius = 4;
+    sun.shadow.bias = -0.0004;
+    sun.shadow.normalBias = 0.02;
+    this.sunDirection = new THREE.Vector3(0.45, 1, 0.3).normalize();
+    this.sun = sun;
+    this.scene.add(sun, sun.target);
+    this.#fitShadow(new THREE.Vector3(0, 1, 0), 6);
+  }
+
+  #makeFloor() {
+    // The grid is a texture, not GL lines: software renderers (headless Chromium's SwiftShader)
+    // draw no lines at all, and a texture also fades out properly at grazing angles.
+    const texture = new THREE.CanvasTexture(drawGridTile());
+    texture.wrapS = texture.wrapT = THREE.RepeatWrapping;
+    texture.repeat.set(kFloorSize / kGridTileMetres, kFloorSize / kGridTileMetres);
+    texture.anisotropy = this.renderer.capabilities.getMaxAnisotropy();
+    texture.colorSpace = THREE.SRGBColorSpace;
+    const plane = new THREE.Mesh(
+      new THREE.PlaneGeometry(kFloorSize, kFloorSize),
+      // Lambert: the floor covers most pixels, and a software renderer pays for every one.
+      new THREE.MeshLambertMaterial({ map: texture }),
+    );
+    plane.rotation.x = -Math.PI / 2;
+    plane.receiveShadow = true;
+    return plane;
+  }
+
+  #makeLabels() {
+    const labels = [];
+    for (let i = 0; i < kMaxLabels; i++) {
+      const el = document.createElement('div');
+      el.className = 'body-label';
+      el.hidden = true;
+      this.container.appendChild(el);
+      labels.push(el);
+    }
+    return labels;
+  }
+
+  /** Rebuilds all meshes for a scene message (docs/protocol.md "scene"). */
+  setScene({ scene, faces, bodies }, { refit }) {
+    const floor = sceneFloor(scene);
+    this.floor.visible = floor !== null;
+    if (floor) this.floor.position.y = floor.height;
+    this.floorHeight = floor ? floor.height : null;
+
+    if (this.boxes) {
+      this.scene.remove(this.boxes, this.edges);
+      this.boxes.geometry.dispose();
+      this.edges.geometry.dispose();
+    }
+    const n = bodies.length;
+    this.bodyCount = n;
+    this.faces = faces;
+    this.baseColors = bodies.map((b) => new THREE.Color(b.color ?? '#d9822b'));
+    this.bodyNames = bodies.map((b, i) => b.name ?? `body ${i}`);
+    this.activity = new Uint8Array(n);
+    this.hasPose = false;
+    if (refit) this.needsFit = true;
+
+    // Boxes: 6 faces × 4 corners each (flat normals), two triangles per face.
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(n * 72), 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(n * 72), 3).setUsage(THREE.DynamicDrawUsage));
+    geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(n * 72), 3));
+    const index = new Uint32Array(n * 36);
+    for (let q = 0; q < n * 6; q++) {
+      const v = q * 4;
+      index.set([v, v + 1, v + 2, v, v + 2, v + 3], q * 6);
+    }
+    geometry.setIndex(new THREE.BufferAttribute(index, 1));
+    const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.55, metalness: 0.05 });
+    this.boxes = new THREE.Mesh(geometry, material);
+    this.boxes.castShadow = true;
+    this.boxes.receiveShadow = true;
+    this.boxes.frustumCulled = false;
+
+    const edgeGeometry = new THREE.BufferGeometry();
+    edgeGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(n * 72), 3).setUsage(THREE.DynamicDrawUsage));
+    edgeGeometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(n * 72), 3));
+    this.edges = new THREE.LineSegments(edgeGeometry,
+      new THREE.LineBasicMaterial({ vertexColors: true, transparent: true, opacity: 0.6 }));
+    this.edges.frustumCulled = false;
+
+    this.boxes.visible = this.edges.visible = false; // until the first frame gives a pose
+    this.scene.add(this.boxes, this.edges);
+    for (let i = 0; i < n; i++) this.#writeColors(i);
+  }
+
+  #writeColors(i) {
+    const color = displayColor(this.baseColors[i], this.activity[i], new THREE.Color());
+    const faceColors = this.boxes.geometry.attributes.color.array;
+    for (let k = 0; k < 24; k++) color.toArray(faceColors, (i * 24 + k) * 3);
+    const edge = this.activity[i] === Activity.frozen ? kFrozenEdgeColor : kEdgeColor;
+    const edgeColors = this.edges.geometry.attributes.color.array;
+    for (let k = 0; k < 24; k++) edge.toArray(edgeColors, (i * 24 + k) * 3);
+  }
+
+  /** Applies a decoded frame: vertex positions, flat normals, activity colours. */
+  applyFrame(frame) {
+    if (!this.boxes || frame.count !== this.bodyCount) return false;
+    const src = frame.vertices;
+    const pos = this.boxes.geometry.attributes.position.array;
+    const nrm = this.boxes.geometry.attributes.normal.array;
+    const edgePos = this.edges.geometry.attributes.position.array;
+    let colorsChanged = false;
+    for (let i = 0; i < frame.count; i++) {
+      const b = i * 24;
+      for (let f = 0; f < 6; f++) {
+        const quad = this.faces[f];
+        const a = b + quad[0] * 3, c = b + quad[2] * 3;
+        const bb = b + quad[1] * 3, d = b + quad[3] * 3;
+        // Normal of a CCW quad a b c d: (c − a) × (d − b), normalised.
+        const ux = src[c] - src[a], uy = src[c + 1] - src[a + 1], uz = src[c + 2] - src[a + 2];
+        const vx = src[d] - src[bb], vy = src[d + 1] - src[bb + 1], vz = src[d + 2] - src[bb + 2];
+        let nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+        const len = Math.hypot(nx, ny, nz) || 1;
+        nx /= len; ny /= len; nz /= len;
+        for (let k = 0; k < 4; k++) {
+          const s = b + quad[k] * 3, o = (i * 24 + f * 4 + k) * 3;
+          pos[o] = src[s]; pos[o + 1] = src[s + 1]; pos[o + 2] = src[s + 2];
+          nrm[o] = nx; nrm[o + 1] = ny; nrm[o + 2] = nz;
+        }
+      }
+      for (let e = 0; e < 12; e++) {
+        for (let k = 0; k < 2; k++) {
+          const s = b + kEdges[e][k] * 3, o = (i * 24 + e * 2 + k) * 3;
+          edgePos[o] = src[s]; edgePos[o + 1] = src[s + 1]; edgePos[o + 2] = src[s + 2];
+        }
+      }
+      if (frame.activity[i] !== this.activity[i]) {
+        this.activity[i] = frame.activity[i];
+        this.#writeColors(i);
+        colorsChanged = true;
+      }
+    }
+    const geometry = this.boxes.geometry;
+    geometry.attributes.position.needsUpdate = true;
+    geometry.attributes.normal.needsUpdate = true;
+    geometry.boundingSphere = null;
+    geometry.boundingBox = null;
+    this.edges.geometry.attributes.position.needsUpdate = true;
+    if (colorsChanged) {
+      geometry.attributes.color.needsUpdate = true;
+      this.edges.geometry.attributes.color.needsUpdate = true;
+    }
+    this.frameVertices = src;
+    this.boxes.visible = this.edges.visible = true;
+    this.hasPose = true;
+
+    if (this.needsFit) {
+      this.#fitCamera();
+      this.needsFit = false;
+    }
+    if (++this.framesSinceShadowFit >= 25) {
+      this.framesSinceShadowFit = 0;
+      const sphere = this.#bodiesSphere();
+      if (sphere) this.#fitShadow(sphere.center, sphere.radius);
+    }
+    return true;
+  }
+
+  /** Bounding sphere of the bodies' current vertices (finite ones only), or null. */
+  #bodiesSphere() {
+    if (!this.hasPose) return null;
+    const geometry = this.boxes.geometry;
+    geometry.computeBoundingBox();
+    const box = geometry.boundingBox;
+    if (box.isEmpty() || !Number.isFinite(box.min.x + box.max.x + box.min.y + box.max.y)) return null;
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    return sphere;
+  }
+
+  #fitShadow(center, radius) {
+    const r = Math.min(Math.max(radius * 1.3 + 1, 4), kMaxShadowExtent);
+    const cam = this.sun.shadow.camera;
+    cam.left = -r; cam.right = r; cam.top = r; cam.bottom = -r;
+    cam.near = 0.1; cam.far = 4 * r + 20;
+    cam.updateProjectionMatrix();
+    this.sun.target.position.copy(center);
+    this.sun.position.copy(center).addScaledVector(this.sunDirection, 2 * r + 10);
+  }
+
+  /** Frames the bodies: the camera looks at their bounds from above and to the side. */
+  #fitCamera() {
+    const sphere = this.#bodiesSphere();
+    if (!sphere) return;
+    const radius = Math.max(sphere.radius, 2.5);
+    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2))) * 1.15;
+    const target = sphere.center.clone();
+    if (this.floorHeight !== null) target.y = Math.max(target.y, this.floorHeight + 0.5);
+    const direction = new THREE.Vector3(0.62, 0.48, 0.95).normalize();
+    this.camera.position.copy(target).addScaledVector(direction, distance);
+    this.controls.target.copy(target);
+    this.camera.near = Math.max(0.01, distance / 500);
+    this.camera.far = distance * 50 + 200;
+    this.camera.updateProjectionMatrix();
+    this.scene.fog.near = distance * 3;
+    this.scene.fog.far = distance * 10 + 40;
+    this.controls.update();
+  }
+
+  /** Re-centres the camera on the bodies at the next frame. */
+  refit() {
+    this.needsFit = true;
+  }
+
+  /**
+   * The body under a canvas point, with the world hit point and the view ray's direction.
+   * @param {number} x client x, px  @param {number} y client y, px
+   * @returns {null | {body: number, point: THREE.Vector3, direction: THREE.Vector3}}
+   */
+  pick(x, y) {
+    if (!this.boxes || !this.hasPose) return null;
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((x - rect.left) / rect.width) * 2 - 1, -((y - rect.top) / rect.height) * 2 + 1);
+    this.raycaster.setFromCamera(ndc, this.camera);
+    const hits = this.raycaster.intersectObject(this.boxes, false);
+    if (hits.length === 0) return null;
+    const hit = hits[0];
+    return { body: Math.floor(hit.faceIndex / 12), point: hit.point.clone(), direction: this.raycaster.ray.direction.clone() };
+  }
+
+  /** Screen position (client px) of a body's centre, or null when it has no pose. */
+  bodyScreenPosition(i) {
+    if (!this.hasPose || i < 0 || i >= this.bodyCount) return null;
+    const c = this.#bodyCentre(i);
+    c.project(this.camera);
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    return { x: rect.left + ((c.x + 1) / 2) * rect.width, y: rect.top + ((1 - c.y) / 2) * rect.height, visible: c.z < 1 };
+  }
+
+  #bodyCentre(i) {
+    const v = this.frameVertices, c = new THREE.Vector3();
+    for (let k = 0; k < 8; k++) c.x += v[i * 24 + k * 3], c.y += v[i * 24 + k * 3 + 1], c.z += v[i * 24 + k * 3 + 2];
+    return c.multiplyScalar(1 / 8);
+  }
+
+  #updateLabels() {
+    let used = 0;
+    if (this.hasPose) {
+      for (let i = 0; i < this.bodyCount && used < kMaxLabels; i++) {
+        if (this.activity[i] !== Activity.frozen) continue;
+        const p = this.bodyScreenPosition(i);
+        if (!p?.visible) continue;
+        const el = this.labels[used++];
+        el.textContent = `✖ frozen: ${this.bodyNames[i]}`;
+        el.style.transform = `translate(${Math.round(p.x)}px, ${Math.round(p.y)}px) translate(-50%, -180%)`;
+        el.hidden = false;
+      }
+    }
+    for (let k = used; k < kMaxLabels; k++) this.labels[k].hidden = true;
+  }
+
+  /** Draws a short-lived arrow ending at `point` along `direction` (feedback for a kick). */
+  showKick(point, direction) {
+    const length = Math.max(0.6, this.camera.position.distanceTo(point) * 0.12);
+    const from = point.clone().addScaledVector(direction, -length);
+    const arrow = new THREE.ArrowHelper(direction, from, length, 0xfff2c0, length * 0.3, length * 0.15);
+    arrow.line.material.transparent = arrow.cone.material.transparent = true;
+    this.scene.add(arrow);
+    this.kicks.push({ arrow, born: performance.now() });
+  }
+
+  #updateKicks(now) {
+    this.kicks = this.kicks.filter(({ arrow, born }) => {
+      const age = (now - born) / kKickMs;
+      if (age >= 1) {
+        this.scene.remove(arrow);
+        arrow.dispose();
+        return false;
+      }
+      arrow.line.material.opacity = arrow.cone.material.opacity = 1 - age;
+      return true;
+    });
+  }
+
+  resize() {
+    const w = this.container.clientWidth, h = this.container.clientHeight;
+    this.camera.aspect = w / Math.max(h, 1);
+    this.camera.updateProjectionMatrix();
+    this.renderer.setSize(w, h);
+  }
+
+  render() {
+    this.controls.update();
+    this.#updateLabels();
+    this.#updateKicks(performance.now());
+    this.renderer.render(this.scene, this.camera);
+  }
+}
