@@ -129,3 +129,22 @@ export const api = {
   /** impulse in N·s and point in metres, world frame. */
   impulse: (body, impulse, point) => request('POST', 'impulse', { body, impulse, point }),
 };
+
+/**
+ * Polls GET /api/state every `everyMs` while `when()` is true, one request at a time; failures
+ * are ignored (the stream's state already tells the user when the server is gone).
+ */
+export function pollState({ everyMs, when, onState }) {
+  let busy = false;
+  return setInterval(async () => {
+    if (busy || !when()) return;
+    busy = true;
+    try {
+      onState(await api.state());
+    } catch {
+      // next tick tries again
+    } finally {
+      busy = false;
+    }
+  }, everyMs);
+}

@@ -29,6 +29,8 @@ export class Hud {
     this.frameSamples = [];    // [wall ms, sim time s] of recent frames
     this.renderTimes = [];     // wall ms of recent animation frames
     this.lastRefresh = 0;
+    this.serverRtf = null;     // from GET /api/state
+    this.serverRtfAt = 0;      // wall ms when it came
   }
 
   setConnection(state, detail = {}) {
@@ -85,18 +87,34 @@ export class Hud {
     return rate(this.renderTimes.length, this.renderTimes[0], this.renderTimes[this.renderTimes.length - 1]);
   }
 
-  /** Frames per second received from the server. */
+  /** Frames per second received from the server over the last window (bursts do not inflate it). */
   get streamFps() {
-    const s = this.frameSamples;
-    return s.length ? rate(s.length, s[0][0], s[s.length - 1][0]) : 0;
+    const now = performance.now();
+    let n = 0;
+    for (const [wall] of this.frameSamples) if (now - wall <= kRateWindowMs) n++;
+    return (n * 1000) / kRateWindowMs;
   }
 
-  /** Sim seconds per wall second over the last second of frames (0 while paused). */
+  /**
+   * Sim seconds per wall second: the server's own figure from GET /api/state when it is fresh,
+   * else measured from the frames (0 while paused).
+   */
   get realTimeFactor() {
+    if (this.paused) return 0;
+    if (this.serverRtf !== null && performance.now() - this.serverRtfAt < 2500) return this.serverRtf;
     const s = this.frameSamples;
-    if (s.length < 2 || this.paused) return 0;
+    if (s.length < 2) return 0;
     const wall = (s[s.length - 1][0] - s[0][0]) / 1000;
     return wall > 0 ? (s[s.length - 1][1] - s[0][1]) / wall : 0;
+  }
+
+  /** Takes the server's view from GET /api/state (real-time factor, integrator). */
+  setServerState(state) {
+    if (Number.isFinite(state.real_time_factor)) {
+      this.serverRtf = state.real_time_factor;
+      this.serverRtfAt = performance.now();
+    }
+    if (state.integrator) this.integrator = state.integrator;
   }
 
   refresh(now, force) {

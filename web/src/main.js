@@ -1,6 +1,6 @@
 // Entry point: wires the stream to the viewer, HUD, energy plot and controls; runs the render loop.
 import { Viewer } from './viewer.js';
-import { StreamConnection, streamUrl } from './connection.js';
+import { StreamConnection, pollState, streamUrl } from './connection.js';
 import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
@@ -38,6 +38,18 @@ const connection = new StreamConnection(streamUrl(), {
   },
   onError(error) {
     console.warn('tumble stream:', error);
+  },
+});
+
+// The server's real-time factor and integrator, twice a second. /api/state lists every body, so
+// large scenes skip it and the HUD measures the real-time factor from the frames instead.
+const kMaxPolledBodies = 2000;
+pollState({
+  everyMs: 500,
+  when: () => connection.state === 'open' && !document.hidden && viewer.bodyCount <= kMaxPolledBodies,
+  onState(state) {
+    hud.setServerState(state);
+    controls.setIntegrator(state.integrator);
   },
 });
 

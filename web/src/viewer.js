@@ -37,6 +37,19 @@ function drawGridTile() {
   return canvas;
 }
 
+/** Bounds of a scene's bodies at their initial poses (spheres around each centre), or null. */
+function initialBounds(scene) {
+  const box = new THREE.Box3();
+  for (const body of scene?.bodies ?? []) {
+    const p = body.position, size = body.size ?? [1, 1, 1];
+    if (!Array.isArray(p) || !p.every(Number.isFinite)) continue;
+    const r = 0.5 * Math.hypot(...size);
+    box.expandByPoint(new THREE.Vector3(p[0] - r, p[1] - r, p[2] - r));
+    box.expandByPoint(new THREE.Vector3(p[0] + r, p[1] + r, p[2] + r));
+  }
+  return box.isEmpty() ? null : box;
+}
+
 /** Colour of a body for its activity: asleep ones desaturated, frozen ones tinted red. */
 function displayColor(base, activity, out) {
   out.copy(base);
@@ -155,6 +168,7 @@ export class Viewer {
     this.bodyNames = bodies.map((b, i) => b.name ?? `body ${i}`);
     this.activity = new Uint8Array(n);
     this.hasPose = false;
+    this.sceneBounds = initialBounds(scene);
     if (refit) this.needsFit = true;
 
     // Boxes: 6 faces × 4 corners each (flat normals), two triangles per face.
@@ -282,13 +296,21 @@ export class Viewer {
 
   /** Frames the bodies: the camera looks at their bounds from above and to the side. */
   #fitCamera() {
-    const sphere = this.#bodiesSphere();
-    if (!sphere) return;
-    const radius = Math.max(sphere.radius, 2.5);
-    const distance = (radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2))) * 1.15;
+    const box = new THREE.Box3();
+    const current = this.#bodiesSphere();
+    if (current) current.getBoundingBox(box);
+    if (this.sceneBounds) box.union(this.sceneBounds);
+    if (box.isEmpty()) return;
+    if (this.floorHeight !== null) box.expandByPoint(new THREE.Vector3(box.min.x, this.floorHeight, box.min.z));
+    const sphere = box.getBoundingSphere(new THREE.Sphere());
+    const radius = Math.max(sphere.radius, 2);
+    const halfFov = THREE.MathUtils.degToRad(this.camera.fov / 2);
+    const fit = Math.min(halfFov, Math.atan(Math.tan(halfFov) * this.camera.aspect));
+    const distance = (radius / Math.sin(fit)) * 1.05;
+    // Aim a little below the centre: the overlays sit at the screen's corners and bottom.
     const target = sphere.center.clone();
-    if (this.floorHeight !== null) target.y = Math.max(target.y, this.floorHeight + 0.5);
-    const direction = new THREE.Vector3(0.62, 0.48, 0.95).normalize();
+    target.y -= radius * 0.12;
+    const direction = new THREE.Vector3(0.62, 0.5, 0.95).normalize();
     this.camera.position.copy(target).addScaledVector(direction, distance);
     this.controls.target.copy(target);
     this.camera.near = Math.max(0.01, distance / 500);

@@ -1,0 +1,233 @@
+// Browser test of the viewer against the real server: headless Chromium (Debian's, driven by
+// playwright-core) opens the page and the test looks at what a person would see.
+//
+//   node --test tests/e2e/viewer.test.mjs
+//
+// Env: TUMBLE_SERVER  path of tumble-server (default build/release/server/tumble-server)
+//      TUMBLE_E2E_SHOTS  directory to keep the screenshots in (default: a temp dir, removed)
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath, pathToFileURL } from 'node:url';
+import { decodePng } from './png.mjs';
+
+const kRepo = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
+const kServer = process.env.TUMBLE_SERVER || path.join(kRepo, 'build/release/server/tumble-server');
+const kPlaywright = path.join(kRepo, 'web/node_modules/playwright-core/index.mjs');
+const kChromium = '/usr/bin/chromium';
+const kChromiumArgs = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
+  '--disable-component-update', '--disable-sync', '--no-first-run', '--enable-unsafe-swiftshader'];
+const kViewport = { width: 800, height: 600 };
+const kBoxColor = [0xd9, 0x82, 0x2b]; // the seed scene's box, #d9822b
+
+const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
+
+/** Polls `probe` until it returns a truthy value; fails with `what` after `timeoutMs`. */
+async function until(what, probe, timeoutMs = 15000, everyMs = 150) {
+  const end = Date.now() + timeoutMs;
+  let last;
+  for (;;) {
+    try {
+      last = await probe();
+      if (last) return last;
+    } catch (e) {
+      last = e;
+    }
+    if (Date.now() > end) assert.fail(`timed out after ${timeoutMs} ms waiting for ${what} (last: ${last})`);
+    await sleep(everyMs);
+  }
+}
+
+/** Starts tumble-server; resolves with {child, port} once it prints its URL. */
+function startServer(port) {
+  const env = { ...process.env };
+  delete env.TUMBLE_TOKEN; // POSTs from the page carry no token
+  delete env.TUMBLE_PORT;
+  const child = spawn(kServer, ['--port', String(port), '--scene', 'seed', '--web-root', path.join(kRepo, 'web')],
+    { env, stdio: ['ignore', 'pipe', 'pipe'] });
+  let output = '';
+  return new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`server printed no URL in 10 s:\n${output}`)), 10000);
+    const onData = (chunk) => {
+      output += chunk;
+      const match = /Tumble viewer: http:\/\/[^:\s]+:(\d+)\//.exec(output);
+      if (match) {
+        clearTimeout(timer);
+        resolve({ child, port: Number(match[1]) });
+      }
+    };
+    child.stdout.on('data', onData);
+    child.stderr.on('data', onData);
+    child.on('exit', (code) => {
+      clearTimeout(timer);
+      reject(new Error(`server exited with ${code}:\n${output}`));
+    });
+  });
+}
+
+async function stopServer(child) {
+  if (child.exitCode !== null || child.signalCode !== null) return;
+  const exited = new Promise((resolve) => child.once('exit', resolve));
+  child.kill('SIGTERM');
+  const timer = setTimeout(() => child.kill('SIGKILL'), 3000);
+  await exited;
+  clearTimeout(timer);
+}
+
+/** Counts the pixels whose colour is the box's orange under some lighting; returns their centroid. */
+function findBoxPixels(png) {
+  const { width, height, rgba } = decodePng(png);
+  const [br, bg, bb] = kBoxColor;
+  let count = 0, sx = 0, sy = 0;
+  for (let y = 0; y < height; y++) {
+    for (let x = 0; x < width; x++) {
+      const i = (y * width + x) * 4;
+      const r = rgba[i], g = rgba[i + 1], b = rgba[i + 2];
+      if (r < 60) continue;
+      // Same chromaticity as #d9822b within a tolerance: lighting scales all channels alike.
+      const k = r / br;
+      if (Math.abs(g - bg * k) < 22 && Math.abs(b - bb * k) < 22 && r - b > 50) {
+        count++;
+        sx += x;
+        sy += y;
+      }
+    }
+  }
+  return { count, share: count / (width * height), x: count ? sx / count : NaN, y: count ? sy / count : NaN };
+}
+
+async function getJson(base, route) {
+  const response = await fetch(`${base}api/${route}`);
+  assert.equal(response.status, 200, `GET /api/${route}`);
+  return response.json();
+}
+
+const hudTime = async (page) => parseFloat(await page.locator('#hud-time').textContent());
+
+test('viewer: renders the box, HUD time runs, pause stops it, click kicks the box, reconnects after a restart',
+  { timeout: 88000 }, async (t) => {
+    if (!fs.existsSync(kServer)) {
+      t.skip(`no server binary at ${kServer} (build it, or set TUMBLE_SERVER)`);
+      return;
+    }
+    assert.ok(fs.existsSync(kPlaywright), `playwright-core missing: run "npm ci" in ${path.join(kRepo, 'web')}`);
+    assert.ok(fs.existsSync(kChromium), `no browser at ${kChromium} (apt-get install chromium)`);
+    const { chromium } = await import(pathToFileURL(kPlaywright).href);
+
+    const started = Date.now();
+    const userData = fs.mkdtempSync(path.join(os.tmpdir(), 'tumble-e2e-chromium-'));
+    const shots = process.env.TUMBLE_E2E_SHOTS || fs.mkdtempSync(path.join(os.tmpdir(), 'tumble-e2e-shots-'));
+    fs.mkdirSync(shots, { recursive: true });
+    let server = await startServer(0);
+    const base = `http://127.0.0.1:${server.port}/`;
+    let context;
+    t.after(async () => {
+      await context?.close().catch(() => {});
+      await stopServer(server.child);
+      fs.rmSync(userData, { recursive: true, force: true });
+      if (!process.env.TUMBLE_E2E_SHOTS) fs.rmSync(shots, { recursive: true, force: true });
+    });
+
+    context = await chromium.launchPersistentContext(userData, {
+      executablePath: kChromium, headless: true, args: kChromiumArgs, viewport: kViewport,
+    });
+    const page = context.pages()[0] ?? await context.newPage();
+    const pageErrors = [];
+    page.on('pageerror', (e) => pageErrors.push(e.message));
+    const snap = async (name) => {
+      // Wait for two more drawn frames, so the picture shows the current state.
+      const drawn = await page.evaluate(() => window.tumble.framesDrawn);
+      await until('two more drawn frames', () => page.evaluate((n) => window.tumble.framesDrawn >= n + 2, drawn));
+      const png = await page.screenshot({ path: path.join(shots, `${name}.png`) });
+      return findBoxPixels(png);
+    };
+
+    await page.goto(base);
+    await until('the stream to connect and frames to be drawn',
+      () => page.evaluate(() => window.tumble?.connected && window.tumble.framesDrawn >= 2), 30000);
+    assert.equal(await page.evaluate(() => window.tumble.bodies), 1, 'the seed scene has one body');
+    const webgl = await page.evaluate(() => !!document.querySelector('#stage canvas')?.getContext('webgl2'));
+    assert.ok(webgl, 'the page draws with WebGL 2');
+
+    await t.test('the box is drawn in its colour', async () => {
+      const seen = await snap('1-running');
+      assert.ok(seen.count > 400, `expected orange box pixels, found ${seen.count}`);
+      assert.ok(seen.share < 0.5, `orange covers ${(100 * seen.share).toFixed(0)}% of the page: not a box`);
+    });
+
+    await t.test('the HUD sim time advances', async () => {
+      const t0 = await hudTime(page);
+      await until('the HUD sim time to advance by 0.3 s', async () => (await hudTime(page)) > t0 + 0.3);
+      const text = await page.locator('#hud').innerText();
+      assert.match(text, /live/, 'HUD shows the connection as live');
+      assert.match(text, /fps/);
+      assert.match(text, /dropped frames/);
+    });
+
+    let paused;
+    await t.test('the Pause button stops the simulation', async () => {
+      await page.getByRole('button', { name: 'Pause', exact: true }).click();
+      await until('the server to report paused', async () => (await getJson(base, 'state')).paused === true);
+      await until('the HUD to show paused', async () => (await page.locator('#hud').innerText()).includes('paused'));
+      await until('the button to read Resume', () => page.getByRole('button', { name: 'Resume', exact: true }).isVisible());
+      const h0 = await hudTime(page);
+      const s0 = (await getJson(base, 'state')).time;
+      await sleep(1200);
+      assert.equal(await hudTime(page), h0, 'HUD sim time is frozen while paused');
+      assert.equal((await getJson(base, 'state')).time, s0, 'server sim time is frozen while paused');
+      paused = await snap('2-paused');
+      assert.ok(paused.count > 400, `box visible while paused (${paused.count} px)`);
+    });
+
+    await t.test('clicking the box kicks it', async () => {
+      const scene = await getJson(base, 'scene');
+      const mass = scene.bodies[0].mass ?? 1;
+      const before = (await getJson(base, 'state')).bodies[0];
+      await page.mouse.click(paused.x, paused.y);
+      const after = await until('the impulse to change the body velocity', async () => {
+        const body = (await getJson(base, 'state')).bodies[0];
+        const dv = Math.hypot(...body.velocity.map((v, k) => v - before.velocity[k]));
+        return dv > 0.5 ? body : null;
+      }, 10000);
+      const dv = after.velocity.map((v, k) => v - before.velocity[k]);
+      const speed = Math.hypot(...dv);
+      // The panel's default impulse is 3 N·s along the view ray: Δv = 3 / m.
+      assert.ok(Math.abs(speed - 3 / mass) < 0.3 * (3 / mass), `|Δv| = ${speed.toFixed(3)} m/s, expected ${3 / mass}`);
+      assert.ok(dv[1] < 0, 'the view ray points down at the box, so the kick does too');
+      assert.ok(Math.hypot(dv[0], dv[2]) > 0.3, 'the kick has a horizontal part');
+      const w = Math.hypot(...after.angular_velocity.map((v, k) => v - before.angular_velocity[k]));
+      assert.ok(w >= 0, 'angular velocity is reported');
+
+      await page.getByRole('button', { name: 'Resume', exact: true }).click();
+      await until('the box to drift sideways after the kick', async () => {
+        const body = (await getJson(base, 'state')).bodies[0];
+        return Math.hypot(body.position[0] - before.position[0], body.position[2] - before.position[2]) > 0.2;
+      }, 10000);
+    });
+
+    await t.test('the page reconnects after a server restart', async () => {
+      const port = server.port;
+      await stopServer(server.child);
+      await until('the page to notice the lost connection', () => page.evaluate(() => !window.tumble.connected), 10000);
+      await until('the HUD to say reconnecting', async () => (await page.locator('#hud').innerText()).includes('reconnecting'));
+      server = await startServer(port);
+      await until('the page to reconnect', () => page.evaluate(() => window.tumble.connected && window.tumble.connects >= 2), 20000);
+      const frames = await page.evaluate(() => window.tumble.frames);
+      const t0 = await until('frames of the new server', async () => {
+        const shown = await page.evaluate(() => window.tumble.simTime);
+        const state = await getJson(base, 'state');
+        const more = await page.evaluate((n) => window.tumble.frames > n + 5, frames);
+        return more && Math.abs(shown - state.time) < 1 ? shown + 1e-9 : null;
+      });
+      await until('the HUD sim time to advance again', async () => (await hudTime(page)) > t0 + 0.2);
+      const seen = await snap('3-reconnected');
+      assert.ok(seen.count > 400, `box drawn again after the restart (${seen.count} px)`);
+    });
+
+    assert.deepEqual(pageErrors, [], 'no uncaught errors in the page');
+    const seconds = (Date.now() - started) / 1000;
+    t.diagnostic(`browser test took ${seconds.toFixed(1)} s; screenshots in ${shots}`);
+  });
