@@ -1,5 +1,7 @@
 #include "tumble/body.hpp"
 
+#include <cmath>
+
 namespace tumble {
 
 BodyConstants make_body_constants(const BodyDef& def, double floor_restitution,
@@ -15,6 +17,13 @@ BodyConstants make_body_constants(const BodyDef& def, double floor_restitution,
   c.bounding_radius = c.half_extents.norm();
   c.restitution = def.restitution.value_or(floor_restitution);
   c.friction = def.friction.value_or(floor_friction);
+  const double tol = 1e-14 * c.inertia.maxCoeff();
+  const bool xy = std::abs(c.inertia.x() - c.inertia.y()) <= tol;
+  const bool yz = std::abs(c.inertia.y() - c.inertia.z()) <= tol;
+  const bool xz = std::abs(c.inertia.x() - c.inertia.z()) <= tol;
+  c.shape = (xy && yz) ? InertiaShape::isotropic
+            : (xy || yz || xz) ? InertiaShape::symmetric
+                               : InertiaShape::general;
   return c;
 }
 

@@ -162,12 +162,20 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   Impulses normal = solve_normal(s, k, set, target);
   if (mu <= 0.0) return set.count;
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
+  double twist = 0.0;  // torsional impulse about the normal, N·m·s
+  const Vec3 up = Vec3::UnitY();
   for (int round = 0; round < 16; ++round) {
     double total = 0.0;
     Vec3 centroid = Vec3::Zero();
     for (int i = 0; i < set.count; ++i) total += normal[i], centroid += normal[i] * set.r[i];
     if (total <= 0.0) break;
     centroid /= total;
+    double radius = 0.0;  // load-weighted mean distance from the centroid in the floor plane
+    for (int i = 0; i < set.count; ++i) {
+      const Vec3 d = set.r[i] - centroid;
+      radius += normal[i] * std::hypot(d.x(), d.z());
+    }
+    radius /= total;
     const Mat3 rx = skew(centroid);
     const Mat3 mass3 = k.inv_mass * Mat3::Identity() - rx * k.inv_inertia * rx;
     Eigen::Matrix2d kt;
@@ -175,11 +183,19 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
     const Vec3 u = k.point_velocity(centroid);
     Eigen::Vector2d next = friction - kt.inverse() * Eigen::Vector2d(u.x(), u.z());
     if (next.norm() > mu * total) next *= mu * total / next.norm();
-    const bool settled = (next - friction).norm() <= 1e-13 * (1.0 + next.norm());
+    // Torsional friction of the patch: a face spinning on the floor is braked by at most
+    // μ N times the mean lever of its load; a single point contact has none.
+    double next_twist = twist - k.w.y() / k.inv_inertia(1, 1);
+    next_twist = std::clamp(next_twist, -mu * total * radius, mu * total * radius);
+    const bool settled = (next - friction).norm() <= 1e-13 * (1.0 + next.norm()) &&
+                         std::abs(next_twist - twist) <= 1e-13 * (1.0 + std::abs(next_twist));
     friction = next;
+    twist = next_twist;
     s = s0;
     k = k0;
     k.apply(s, centroid, Vec3(friction.x(), 0.0, friction.y()));
+    s.L += twist * up;
+    k.w += k.inv_inertia * (twist * up);
     normal = solve_normal(s, k, set, target);
     if (settled) break;
   }

@@ -62,10 +62,7 @@ BodyState symplectic_euler(const BodyState& s, const BodyConstants& c, const Vec
   BodyState r = s;
   r.P = s.P + h * c.mass * g;
   r.x = s.x + h * c.inv_mass * r.P;
-  if (!s.L.isZero()) {
-    r.R = rotation_from_vector(h * angular_velocity(s, c)) * s.R;
-    orthonormalize(r.R);
-  }
+  if (!s.L.isZero()) r.R = rotation_from_vector(h * angular_velocity(s, c)) * s.R;
   return r;
 }
 
@@ -92,14 +89,14 @@ BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants
   r.L = s.L;
   if (s.L.isZero()) {
     r.R = s.R;  // No spin: nothing to rotate.
+  } else if (c.shape == InertiaShape::isotropic) {
+    // A cube: ω = L / I is constant, the flow is one rotation (exact for both methods).
+    r.R = rotation_from_vector((h * c.inv_inertia.x()) * s.L) * s.R;
   } else if (integrator == Integrator::exact) {
     r.R = free_rotation_exact(c.inertia, s.R, s.L, h);
   } else {
     r.R = free_rotation_splitting(c.inertia, s.R, s.L, h);
   }
-  // Products of exact rotations still gather round-off; one polar step keeps ‖RᵀR − I‖ at
-  // 1e-15 over millions of steps for about 60 flops.
-  if (!s.L.isZero()) orthonormalize(r.R);
   return r;
 }
 

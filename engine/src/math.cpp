@@ -12,8 +12,9 @@ Mat3 skew(const Vec3& a) {
   return m;
 }
 
-// Rodrigues' formula; below 1e-4 rad the Taylor series of sin θ/θ and (1 − cos θ)/θ² to θ⁴
-// keeps full precision where the closed form would cancel.
+// Rodrigues' formula R = I + a K + b K² with K = skew(v), expanded so that no 3×3 product is
+// formed (K² = v vᵀ − |v|² I). Below 1e-4 rad the Taylor series of sin θ/θ and (1 − cos θ)/θ²
+// to θ⁴ keeps full precision where the closed form would cancel.
 Mat3 rotation_from_vector(const Vec3& v) {
   const double theta2 = v.squaredNorm();
   double a, b;
@@ -25,8 +26,12 @@ Mat3 rotation_from_vector(const Vec3& v) {
     a = std::sin(theta) / theta;
     b = (1.0 - std::cos(theta)) / theta2;
   }
-  const Mat3 k = skew(v);
-  Mat3 r = Mat3::Identity() + a * k + b * (k * k);
+  const double d = 1.0 - b * theta2;
+  const Vec3 av = a * v;
+  Mat3 r;
+  r << d + b * v.x() * v.x(), b * v.x() * v.y() - av.z(), b * v.x() * v.z() + av.y(),
+       b * v.x() * v.y() + av.z(), d + b * v.y() * v.y(), b * v.y() * v.z() - av.x(),
+       b * v.x() * v.z() - av.y(), b * v.y() * v.z() + av.x(), d + b * v.z() * v.z();
   return r;
 }
 
@@ -50,6 +55,14 @@ void orthonormalize(Mat3& R) {
   R = R * (1.5 * Mat3::Identity() - 0.5 * rtr);
   Vec3 c0 = R.col(0).normalized();
   Vec3 c1 = (R.col(1) - c0.dot(R.col(1)) * c0).normalized();
+  R.col(0) = c0;
+  R.col(1) = c1;
+  R.col(2) = c0.cross(c1);
+}
+
+void gram_schmidt(Mat3& R) {
+  const Vec3 c0 = R.col(0).normalized();
+  const Vec3 c1 = (R.col(1) - c0.dot(R.col(1)) * c0).normalized();
   R.col(0) = c0;
   R.col(1) = c1;
   R.col(2) = c0.cross(c1);

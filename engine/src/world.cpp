@@ -4,6 +4,7 @@
 #include <string>
 
 #include "floor_contact.hpp"
+#include "integrators.hpp"
 
 namespace tumble {
 namespace {
@@ -14,9 +15,13 @@ constexpr double kSleepTime = 0.5;    // s of stillness in contact before sleepi
 /// Stage: a body that has been slow while touching the floor for kSleepTime falls asleep
 /// (its momenta are zeroed, so it is exactly still); Box2D's rule, Catto 2023 "islands".
 void update_sleep(Body& b, bool touched, double dt) {
+  if (!touched) {
+    b.still_time = 0.0;
+    return;
+  }
   const double speed = (b.s.P * b.c.inv_mass).norm() +
                        angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
-  if (!touched || speed > kSleepSpeed) {
+  if (speed > kSleepSpeed) {
     b.still_time = 0.0;
     return;
   }
@@ -60,6 +65,7 @@ void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0)) throw InvalidInput("dt must be finite and > 0");
   last_ = {};
   const WorldDef& w = scene_.world;
+  const bool renormalize = (steps_ + 1) % kGramSchmidtInterval == 0;
   for (Body& b : bodies_) {
     if (b.activity != Activity::awake) continue;
     ++last_.awake;
@@ -74,6 +80,7 @@ void World::step(double dt) {
       ++last_.newly_frozen;
       continue;
     }
+    if (renormalize) gram_schmidt(b.s.R);
     update_sleep(b, r.touched, dt);
   }
   total_impacts_ += last_.impacts;

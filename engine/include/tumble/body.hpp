@@ -31,6 +31,13 @@ struct BodyState {
   Vec3 L = Vec3::Zero();   ///< Angular momentum about the centre of mass, kg·m²/s.
 };
 
+/// Which closed form the torque-free rotation of a box has (decided once, from I_body).
+enum class InertiaShape : unsigned char {
+  isotropic,  ///< Three equal moments (a cube): ω is constant, one rotation per step.
+  symmetric,  ///< Two equal moments: regular precession.
+  general,    ///< Three distinct moments: Jacobi elliptic functions.
+};
+
 /// Constants of a box derived from its definition once (principal axes = body axes).
 struct BodyConstants {
   double mass = 1.0;                     ///< kg.
@@ -41,6 +48,7 @@ struct BodyConstants {
   double bounding_radius = 0.866;        ///< |half_extents|, m.
   double restitution = 1.0;              ///< e used against the floor.
   double friction = 0.0;                 ///< μ used against the floor.
+  InertiaShape shape = InertiaShape::isotropic;  ///< Closed form of its free rotation.
 };
 
 /// Computes the box constants (inertia of a solid cuboid: m/12 (b² + c²) …).

@@ -21,6 +21,10 @@ Mat3 axis_rotation(int axis, double angle);
 /// Re-orthonormalises R in place (symmetric polar step, then a Gram–Schmidt finish).
 void orthonormalize(Mat3& R);
 
+/// Column Gram–Schmidt in place: enough for an R that is a product of exact rotations and
+/// only gathers round-off (about a third of orthonormalize's cost).
+void gram_schmidt(Mat3& R);
+
 /// ‖RᵀR − I‖ (Frobenius): how far R is from a rotation.
 double orthonormality_error(const Mat3& R);
 
