@@ -150,7 +150,7 @@ std::string work_precision_tumble(const Options& o, Progress& bar) {
      << image_link(o, p2, "tumble energy error vs CPU time") << "\n\n"
      << image_link(o, p3, "tumble |L| error vs CPU time") << "\n\n"
      << "At dt = 1/30 s:\n\n"
-     << md_table({"integrator", "angle error (rad)", "energy rel. error", "|L| rel. error",
+     << md_table({"integrator", "angle error (rad)", "energy rel. error", "‖L‖ rel. error",
                   "CPU ms per 20 s run"},
                  rows)
      << "\nWhat it shows: each curve walks from the largest step (left, cheapest) to the "
