@@ -28,7 +28,7 @@ export class EnergyPlot {
       scales: { x: { time: false } },
       axes: [
         { ...axisStyle, size: 22, values: (u, ticks) => ticks.map((t) => `${t.toFixed(0)} s`) },
-        { ...axisStyle, size: 52, values: (u, ticks) => ticks.map(formatJoules) },
+        { ...axisStyle, size: 58, values: (u, ticks) => ticks.map(formatJoules) },
       ],
       series: [{}, { label: 'E', stroke: '#f0a04b', width: 1.5, points: { show: false } }],
     }, [[], []], container);
@@ -78,13 +78,19 @@ export class EnergyPlot {
     }
     const e = this.energies[n - 1];
     const drift = e - this.reference;
-    const relative = Math.abs(this.reference) > 1e-9 ? ` (${(100 * drift / Math.abs(this.reference)).toFixed(2)}%)` : '';
+    let relative = '';
+    if (Math.abs(this.reference) > 1e-9) {
+      const r = drift / Math.abs(this.reference);
+      relative = Math.abs(r) >= 1e-4 ? ` (${(100 * r).toFixed(2)}%)` : r === 0 ? '' : ` (${r.toExponential(0)} rel.)`;
+    }
     this.readout.textContent = `E ${formatJoules(e)}  ΔE ${drift >= 0 ? '+' : ''}${formatJoules(drift)}${relative}`;
   }
 }
 
 function formatJoules(value) {
   const a = Math.abs(value);
-  if (a >= 1e5 || (a > 0 && a < 1e-2)) return `${value.toExponential(1)} J`;
+  if (a >= 1e9 || (a > 0 && a < 1e-2)) return `${value.toExponential(1)} J`;
+  if (a >= 1e6) return `${(value / 1e6).toFixed(a >= 1e8 ? 0 : 1)} MJ`;
+  if (a >= 1e4) return `${(value / 1e3).toFixed(a >= 1e5 ? 0 : 1)} kJ`;
   return `${value.toFixed(a >= 100 ? 0 : a >= 10 ? 1 : 2)} J`;
 }

@@ -15,7 +15,7 @@ const kKickMs = 700; // lifetime of the kick arrow
 // The 12 box edges as vertex-index pairs (vertex i: bit 0 → +x, bit 1 → +y, bit 2 → +z).
 const kEdges = [[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7], [0, 4], [1, 5], [2, 6], [3, 7]];
 
-const kFloorSize = 400;     // m, edge of the square floor
+const kFloorSize = 1000;    // m, edge of the square floor (it follows the camera's target)
 const kGridTileMetres = 5; // one texture tile: 5 × 5 one-metre cells
 
 /** A 5 m × 5 m floor tile: a line every metre, a stronger one on the tile's edge. */
@@ -316,13 +316,15 @@ export class Viewer {
     this.camera.near = Math.max(0.01, distance / 500);
     this.camera.far = distance * 50 + 200;
     this.camera.updateProjectionMatrix();
-    this.scene.fog.near = distance * 3;
-    this.scene.fog.far = distance * 10 + 40;
+    // The fog hides the floor's edge: it ends before half the floor's size.
+    this.scene.fog.far = Math.min(distance * 10 + 40, kFloorSize * 0.45);
+    this.scene.fog.near = Math.min(distance * 3, this.scene.fog.far * 0.5);
     this.controls.update();
   }
 
-  /** Re-centres the camera on the bodies at the next frame. */
+  /** Re-centres the camera on the bodies' current poses at the next frame. */
   refit() {
+    this.sceneBounds = null;
     this.needsFit = true;
   }
 
@@ -405,6 +407,10 @@ export class Viewer {
 
   render() {
     this.controls.update();
+    // Keep the (finite) floor under the view, moved by whole grid tiles so the grid stays put.
+    const t = this.controls.target;
+    this.floor.position.x = Math.round(t.x / kGridTileMetres) * kGridTileMetres;
+    this.floor.position.z = Math.round(t.z / kGridTileMetres) * kGridTileMetres;
     this.#updateLabels();
     this.#updateKicks(performance.now());
     this.renderer.render(this.scene, this.camera);
