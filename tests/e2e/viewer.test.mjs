@@ -20,7 +20,7 @@ const kPlaywright = path.join(kRepo, 'web/node_modules/playwright-core/index.mjs
 const kChromium = '/usr/bin/chromium';
 const kChromiumArgs = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
   '--disable-component-update', '--disable-sync', '--no-first-run', '--enable-unsafe-swiftshader'];
-const kViewport = { width: 800, height: 600 };
+const kViewport = { width: 720, height: 540 };
 const kBoxColor = [0xd9, 0x82, 0x2b]; // the seed scene's box, #d9822b
 
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
@@ -182,6 +182,20 @@ test('viewer: renders the box, HUD time runs, pause stops it, click kicks the bo
       assert.ok(paused.count > 400, `box visible while paused (${paused.count} px)`);
     });
 
+    await t.test('Step advances a paused simulation by one step; the integrator menu switches it', async () => {
+      const s0 = await getJson(base, 'state');
+      await page.getByRole('button', { name: 'Step', exact: true }).click();
+      const s1 = await until('one step', async () => {
+        const s = await getJson(base, 'state');
+        return s.step > s0.step ? s : null;
+      });
+      assert.equal(s1.step, s0.step + 1);
+      assert.ok(s1.paused);
+      await until('the HUD to show the stepped time', async () => Math.abs((await hudTime(page)) - s1.time) < 2e-3);
+      await page.getByRole('combobox', { name: 'integrator' }).selectOption('rk4');
+      await until('the server to switch to rk4', async () => (await getJson(base, 'state')).integrator === 'rk4');
+    });
+
     await t.test('clicking the box kicks it', async () => {
       const scene = await getJson(base, 'scene');
       const mass = scene.bodies[0].mass ?? 1;
@@ -225,6 +239,10 @@ test('viewer: renders the box, HUD time runs, pause stops it, click kicks the bo
       await until('the HUD sim time to advance again', async () => (await hudTime(page)) > t0 + 0.2);
       const seen = await snap('3-reconnected');
       assert.ok(seen.count > 400, `box drawn again after the restart (${seen.count} px)`);
+      // Resync: the new server runs the scene's own integrator again, and the menu follows it.
+      const integrator = (await getJson(base, 'state')).integrator;
+      await until(`the integrator menu to show ${integrator}`,
+        async () => (await page.getByRole('combobox', { name: 'integrator' }).inputValue()) === integrator);
     });
 
     assert.deepEqual(pageErrors, [], 'no uncaught errors in the page');

@@ -2,20 +2,26 @@
 // body activity counts, and short error toasts. Also keeps the statistics it shows.
 import { Activity } from './protocol.js';
 
-/** Wall-clock window over which rates are measured, ms. */
+/** Wall-clock window over which frame rates are measured, ms. */
 const kRateWindowMs = 1000;
+/** Longer window for the measured real-time factor: frames arrive in bursts on a busy page. */
+const kRtfWindowMs = 3000;
 /** HUD text refresh interval, ms. */
 const kRefreshMs = 200;
 
 const kStateText = { connecting: 'connecting…', open: 'live', reconnecting: 'reconnecting…' };
 
 export class Hud {
-  /** @param {HTMLElement} root element holding the `[data-field]` spans */
+  /**
+   * @param {HTMLElement} root the HUD card (gets data-connection, data-paused, data-frozen)
+   * @param {HTMLElement} toastBox where error toasts go
+   * Text goes to every element of the page with a matching `data-field`.
+   */
   constructor(root, toastBox) {
     this.root = root;
     this.toastBox = toastBox;
     this.fields = {}; // field name → elements showing it
-    for (const el of root.querySelectorAll('[data-field]')) (this.fields[el.dataset.field] ??= []).push(el);
+    for (const el of document.querySelectorAll('[data-field]')) (this.fields[el.dataset.field] ??= []).push(el);
     this.connection = 'connecting';
     this.retryInMs = 0;
     this.sceneName = '';
@@ -72,13 +78,13 @@ export class Hud {
     }
     this.counts = { awake: frame.count - asleep - frozen, asleep, frozen };
     this.frameSamples.push([now, frame.time]);
-    trim(this.frameSamples, now, (s) => s[0]);
+    trim(this.frameSamples, now, (s) => s[0], kRtfWindowMs);
   }
 
   /** Records an animation frame at wall time `now` (ms) and refreshes the text now and then. */
   onRender(now) {
     this.renderTimes.push(now);
-    trim(this.renderTimes, now, (t) => t);
+    trim(this.renderTimes, now, (t) => t, kRateWindowMs);
     this.refresh(now, false);
   }
 
@@ -122,14 +128,16 @@ export class Hud {
     this.lastRefresh = now;
     const f = this.fields;
     const live = this.connection === 'open';
-    let connText = kStateText[this.connection] ?? this.connection;
-    if (this.connection === 'reconnecting' && this.retryInMs) connText += ` (retry in ${(this.retryInMs / 1000).toFixed(1)} s)`;
-    this.root.dataset.connection = this.connection;
+    const connText = kStateText[this.connection] ?? this.connection;
+    const retry = this.connection === 'reconnecting' && this.retryInMs
+      ? ` (next try in ${(this.retryInMs / 1000).toFixed(1)} s)` : '';
+    this.root.dataset.connection = document.body.dataset.connection = this.connection;
     set(f.connection, connText);
+    set(f['connection-detail'], connText + retry);
     set(f.scene, this.sceneName || '—');
     set(f.integrator, this.integrator || '—');
     set(f.time, `${this.simTime.toFixed(3)} s`);
-    set(f.paused, this.paused ? 'paused' : 'running');
+    set(f.paused, !live ? 'offline' : this.paused ? 'paused' : 'running');
     this.root.dataset.paused = String(this.paused);
     set(f.rtf, live && !this.paused ? `${this.realTimeFactor.toFixed(2)}×` : '—');
     set(f.fps, `${this.renderFps.toFixed(0)}`);
@@ -155,9 +163,9 @@ function set(elements, text) {
   for (const el of elements ?? []) if (el.textContent !== text) el.textContent = text;
 }
 
-function trim(list, now, wallOf) {
+function trim(list, now, wallOf, windowMs) {
   let drop = 0;
-  while (drop < list.length - 1 && now - wallOf(list[drop]) > kRateWindowMs) drop++;
+  while (drop < list.length - 1 && now - wallOf(list[drop]) > windowMs) drop++;
   if (drop) list.splice(0, drop);
 }
 

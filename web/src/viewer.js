@@ -37,6 +37,16 @@ function drawGridTile() {
   return canvas;
 }
 
+/** True when WebGL runs on a CPU rasteriser (as in headless Chromium). */
+function isSoftwareRenderer() {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  if (!gl) return false;
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  gl.getExtension('WEBGL_lose_context')?.loseContext();
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+
 /** Bounds of a scene's bodies at their initial poses (spheres around each centre), or null. */
 function initialBounds(scene) {
   const box = new THREE.Box3();
@@ -67,8 +77,11 @@ export class Viewer {
   /** @param {HTMLElement} container the element the canvas fills. */
   constructor(container) {
     this.container = container;
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, powerPreference: 'high-performance' });
-    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    // A software rasteriser (SwiftShader, llvmpipe) pays for every pixel: no MSAA, one device
+    // pixel per CSS pixel and a smaller shadow map there.
+    this.software = isSoftwareRenderer();
+    this.renderer = new THREE.WebGLRenderer({ antialias: !this.software, powerPreference: 'high-performance' });
+    this.renderer.setPixelRatio(this.software ? 1 : Math.min(window.devicePixelRatio, 2));
     this.renderer.shadowMap.enabled = true;
     this.renderer.shadowMap.type = THREE.PCFShadowMap;
     container.appendChild(this.renderer.domElement);
@@ -109,7 +122,8 @@ export class Viewer {
     this.scene.add(new THREE.HemisphereLight(0xdfe8ff, 0x40362e, 1.1));
     const sun = new THREE.DirectionalLight(0xfff6ea, 2.8);
     sun.castShadow = true;
-    sun.shadow.mapSize.set(2048, 2048);
+    const mapSize = this.software ? 1024 : 2048;
+    sun.shadow.mapSize.set(mapSize, mapSize);
     sun.shadow.radius = 4;
     sun.shadow.bias = -0.0004;
     sun.shadow.normalBias = 0.02;
