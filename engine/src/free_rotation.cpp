@@ -16,8 +16,10 @@ constexpr double kEqualMoments = 1e-14;
 
 // Boost.Math must not throw inside a step: the arguments below are valid by construction, and
 // should round-off ever make them not, a NaN is returned and the world's finiteness check
-// reports the body.
+// reports the body. By default Boost also evaluates double in long double (promote_double),
+// which made R_J cost ~2 µs here; Carlson's duplication is accurate to a few ulp in double.
 using NoThrow = boost::math::policies::policy<
+    boost::math::policies::promote_double<false>,
     boost::math::policies::domain_error<boost::math::policies::ignore_error>,
     boost::math::policies::pole_error<boost::math::policies::ignore_error>,
     boost::math::policies::overflow_error<boost::math::policies::ignore_error>,
@@ -85,7 +87,7 @@ struct JacobiAgm {
   // an absolute precision, while close to the separatrix cn and dn there are O(k') small and the
   // elliptic integrals depend on their logarithms. So for |r| > K/2 evaluate at v = K − |r| and
   // reflect: sn(K − v) = cn v / dn v, cn(K − v) = k' sn v / dn v, dn(K − v) = k' / dn v
-  // (DLMF 22.4.3), which keeps cn and dn to relative precision.
+  // (DLMF Table 22.4.3), which keeps cn and dn to relative precision.
   void eval_reduced(double r, double kc, double& sn, double& cn, double& dn) const {
     if (std::abs(r) <= 0.5 * quarter_period) {
       eval(r, kc, sn, cn, dn);
@@ -115,25 +117,87 @@ Mat3 momentum_frame(const Vec3& m) {
 
 Mat3 rotation_about_z(double angle) { return axis_rotation(2, angle); }
 
-// The general (three distinct moments) exact flow.
+// The general (three distinct moments) exact flow: elliptic_flow and general_flow.
 //
 // Why: in a canonical body frame (a signed permutation C of the body axes, proper, with the
 // moments J1, J2, J3 ordered so that axis 3 is the one the polhode encircles and m3 > 0),
 // Euler's equations are solved by
 //   m1 = a1 cn u,  m2 = s a2 sn u,  m3 = a3 dn u,  u = u0 + λ t,
-// (Landau & Lifshitz §37, eqs. 37.10–37.12; both sides of the separatrix are the same formulas
+// (Landau & Lifshitz, Mechanics, §37; both sides of the separatrix are the same formulas
 // with axes 1 and 3 exchanged, s = sign(J3 − J2)), and the attitude is
 //   R(t) = R0 Cᵀ P(m0)ᵀ Rz(ψ(t)) P(m(t)) C,
 // where ψ is the rotation about L, ψ̇ = M (m1²/J1 + m2²/J2)/(m1² + m2²). Integrating ψ̇ gives an
 // elliptic integral of the third kind with the constant characteristic
 // n = −J3 (J2 − J1) / (J1 (J3 − J2)) (Celledoni, Fassò, Säfström & Zanna, SIAM J. Sci.
-// Comput. 30(4), 2008, §2). Written with Carlson's symmetric integrals,
+// Comput. 30(4), 2008). Written with Carlson's symmetric integrals,
 // Π(n; am u) = u + (n/3) sn³ R_J(cn², dn², 1, 1 − n sn²), so
 //   ψ(t) = M t / J1 − M (J3 − J1)(J2 − J1) / (3 λ J1² (J3 − J2)) · [ΔR_J terms],
 // with u reduced to r ∈ [−K, K] by whole half periods 2K (each adds the complete R_J).
 // The differences D_i = ±(M² − 2E J_i) are summed from the m_i² with positive weights, so the
 // modulus k'² = (J3 − J1) D2 / ((J3 − J2) D1) keeps its relative precision near the separatrix.
 // Exactly on it (k' = 0) the same formulas hold with sn = tanh, cn = dn = sech and no period.
+//
+// elliptic_flow is the canonical-frame part of general_flow, P(m0)ᵀ Rz(ψ(t)) P(m(t)) for moments J1, J2, J3
+// (axis 3 encircled, m0[2] > 0, m0[0]² + m0[1]² > 0) and D_i as defined there.
+Mat3 elliptic_flow(const Vec3& m0, double J1, double J2, double J3, double D1, double D2,
+                   double D3, double t) {
+  const double M = m0.norm();
+  const double a1 = std::sqrt(J1 * D3 / (J3 - J1));
+  const double a2 = std::sqrt(J2 * D3 / (J3 - J2));
+  const double a3 = std::sqrt(J3 * D1 / (J3 - J1));
+  const double lambda = std::sqrt((J3 - J2) * D1 / (J1 * J2 * J3));
+  const double kc2 = std::max(0.0, (J3 - J1) * D2 / ((J3 - J2) * D1));
+  const double k2 = std::min(1.0, (J2 - J1) * D3 / ((J3 - J2) * D1));
+  const double kc = std::sqrt(kc2), k = std::sqrt(k2);
+  const double n = -J3 * (J2 - J1) / (J1 * (J3 - J2));
+  const double s = J3 > J2 ? 1.0 : -1.0;
+  const bool separatrix = kc2 == 0.0;
+  // On the separatrix cn = sech > 0: use the symmetry (m1, m2) → (−m1, −m2) if m1 < 0.
+  const double sigma1 = separatrix && m0[0] < 0.0 ? -1.0 : 1.0;
+
+  // Initial phase: sn u0, cn u0, reduced to r0 ∈ [−K, K] with half-period index j0.
+  const double x = sigma1 * m0[0] / a1, y = sigma1 * s * m0[1] / a2;
+  const double h = std::hypot(x, y);
+  double sn0 = y / h, cn0 = x / h;
+  int j0 = 0;
+  if (cn0 < 0.0) {
+    j0 = sn0 < 0.0 ? -1 : 1;
+    sn0 = -sn0;
+    cn0 = -cn0;
+  }
+  const double dn0sq = cn0 * cn0 + kc2 * sn0 * sn0;
+  const double r0 = sn0 * carlson_rf(cn0 * cn0, dn0sq, 1.0);  // F(am r0 | k)
+
+  double sn, cn, dn, r;
+  double rj_periods = 0.0;
+  int j = j0;
+  if (separatrix) {
+    r = r0 + lambda * t;
+    sn = std::tanh(r);
+    cn = 1.0 / std::cosh(r);
+    dn = cn;
+  } else {
+    const JacobiAgm agm(k, kc);
+    const double K = agm.quarter_period;
+    const double w = r0 + lambda * t;
+    const double half_periods = std::nearbyint(w / (2.0 * K));
+    r = w - 2.0 * half_periods * K;
+    agm.eval_reduced(r, kc, sn, cn, dn);
+    if (half_periods != 0.0) {
+      rj_periods = 2.0 * half_periods * carlson_rj(0.0, kc2, 1.0, 1.0 - n);
+      j += static_cast<int>(std::fmod(half_periods, 2.0));
+    }
+  }
+  const double parity = (j % 2 == 0) ? 1.0 : -1.0;
+  const Vec3 mt(sigma1 * parity * a1 * cn, sigma1 * s * parity * a2 * sn, a3 * dn);
+
+  const double rj = sn * sn * sn * carlson_rj(cn * cn, dn * dn, 1.0, 1.0 - n * sn * sn);
+  const double rj0 = sn0 * sn0 * sn0 * carlson_rj(cn0 * cn0, dn0sq, 1.0, 1.0 - n * sn0 * sn0);
+  const double c = -M * (J3 - J1) * (J2 - J1) / (3.0 * lambda * J1 * J1 * (J3 - J2));
+  const double psi = M * t / J1 + c * (rj_periods + rj - rj0);
+  return momentum_frame(m0).transpose() * rotation_about_z(psi) * momentum_frame(mt);
+}
+
 Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
                   const std::array<int, 3>& sorted) {
   const Vec3 mb = R.transpose() * L;
@@ -154,8 +218,6 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   sgn[1] = odd ? -sgn[2] : sgn[2];
   Vec3 m0(sgn[0] * mb[perm[0]], sgn[1] * mb[perm[1]], sgn[2] * mb[perm[2]]);
 
-  const double M2 = m0.squaredNorm();
-  const double M = std::sqrt(M2);
   const double D3 = m0[0] * m0[0] * (J3 - J1) / J1 + m0[1] * m0[1] * (J3 - J2) / J2;  // 2E J3 − M²
   const double D1 = m0[1] * m0[1] * (J2 - J1) / J2 + m0[2] * m0[2] * (J3 - J1) / J3;  // M² − 2E J1
   const double D2 = m0[0] * m0[0] * (J1 - J2) / J1 + m0[2] * m0[2] * (J3 - J2) / J3;  // M² − 2E J2
@@ -167,61 +229,7 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
     // Steady spin about canonical axis 3.
     canonical = frame * rotation_about_z(t * m0[2] / J3);
   } else {
-    const double a1 = std::sqrt(J1 * D3 / (J3 - J1));
-    const double a2 = std::sqrt(J2 * D3 / (J3 - J2));
-    const double a3 = std::sqrt(J3 * D1 / (J3 - J1));
-    const double lambda = std::sqrt((J3 - J2) * D1 / (J1 * J2 * J3));
-    const double kc2 = std::max(0.0, (J3 - J1) * D2 / ((J3 - J2) * D1));
-    const double k2 = std::min(1.0, (J2 - J1) * D3 / ((J3 - J2) * D1));
-    const double kc = std::sqrt(kc2), k = std::sqrt(k2);
-    const double n = -J3 * (J2 - J1) / (J1 * (J3 - J2));
-    const double s = J3 > J2 ? 1.0 : -1.0;
-    const bool separatrix = kc2 == 0.0;
-    // On the separatrix cn = sech > 0: use the symmetry (m1, m2) → (−m1, −m2) if m1 < 0.
-    const double sigma1 = separatrix && m0[0] < 0.0 ? -1.0 : 1.0;
-
-    // Initial phase: sn u0, cn u0, reduced to r0 ∈ [−K, K] with half-period index j0.
-    const double x = sigma1 * m0[0] / a1, y = sigma1 * s * m0[1] / a2;
-    const double h = std::hypot(x, y);
-    double sn0 = y / h, cn0 = x / h;
-    int j0 = 0;
-    if (cn0 < 0.0) {
-      j0 = sn0 < 0.0 ? -1 : 1;
-      sn0 = -sn0;
-      cn0 = -cn0;
-    }
-    const double dn0sq = cn0 * cn0 + kc2 * sn0 * sn0;
-    const double r0 = sn0 * carlson_rf(cn0 * cn0, dn0sq, 1.0);  // F(am r0 | k)
-
-    double sn, cn, dn, r;
-    double rj_periods = 0.0;
-    int j = j0;
-    if (separatrix) {
-      r = r0 + lambda * t;
-      sn = std::tanh(r);
-      cn = 1.0 / std::cosh(r);
-      dn = cn;
-    } else {
-      const JacobiAgm agm(k, kc);
-      const double K = agm.quarter_period;
-      const double w = r0 + lambda * t;
-      const double half_periods = std::nearbyint(w / (2.0 * K));
-      r = w - 2.0 * half_periods * K;
-      agm.eval_reduced(r, kc, sn, cn, dn);
-      if (half_periods != 0.0) {
-        rj_periods = 2.0 * half_periods * carlson_rj(0.0, kc2, 1.0, 1.0 - n);
-        j += static_cast<int>(std::fmod(half_periods, 2.0));
-      }
-    }
-    const double parity = (j % 2 == 0) ? 1.0 : -1.0;
-    const Vec3 mt(sigma1 * parity * a1 * cn, sigma1 * s * parity * a2 * sn, a3 * dn);
-
-    const double rj = sn * sn * sn * carlson_rj(cn * cn, dn * dn, 1.0, 1.0 - n * sn * sn);
-    const double rj0 = sn0 * sn0 * sn0 * carlson_rj(cn0 * cn0, dn0sq, 1.0, 1.0 - n * sn0 * sn0);
-    const double c = -M * (J3 - J1) * (J2 - J1) / (3.0 * lambda * J1 * J1 * (J3 - J2));
-    const double psi = M * t / J1 + c * (rj_periods + rj - rj0);
-    (void)k;
-    canonical = frame * momentum_frame(m0).transpose() * rotation_about_z(psi) * momentum_frame(mt);
+    canonical = frame * elliptic_flow(m0, J1, J2, J3, D1, D2, D3, t);
   }
   Mat3 out;
   for (int i = 0; i < 3; ++i) out.col(perm[i]) = sgn[i] * canonical.col(i);
@@ -259,7 +267,13 @@ Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, doub
 Mat3 free_rotation_splitting(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
   std::array<int, 3> sorted{0, 1, 2};
   std::sort(sorted.begin(), sorted.end(), [&](int a, int b) { return inertia[a] < inertia[b]; });
-  // Outer, middle and central flows as indices into the sorted moments (smallest = 0).
+  // Outer, middle and central flows as indices into the sorted moments (smallest = 0):
+  // T_min(h/2) T_mid(h/2) T_max(h) T_mid(h/2) T_min(h/2). The leading error term (and so the
+  // energy error) depends on the ordering by orders of magnitude (Fassò, J. Comput. Phys. 189,
+  // 2003, who also notes one ordering is fourth order for moments ∝ (0.25, 0.75, 1)). Measured
+  // over 36 cases (six inertias incl. the 1×2×3 box, six momenta, h = 0.01 s, 3 s) against the
+  // exact flow, this ordering had the smallest mean error, 5–30× below the other five, and
+  // 1e-10 instead of 1e-5 for (0.25, 0.75, 1).
   constexpr std::array<int, 3> kSplittingOrder{0, 1, 2};
   const int a = sorted[kSplittingOrder[0]], b = sorted[kSplittingOrder[1]],
             c = sorted[kSplittingOrder[2]];

@@ -243,7 +243,10 @@ TEST(FreeRotationExact, ExactlyOnSeparatrix) {
   }
 }
 
-// Steady spins about each principal axis are plain rotations about that axis.
+// Steady spins about each principal axis are plain rotations about that axis. Axis 0 is the
+// middle moment: R0ᵀ(R0 m) leaves ~1e-17 in the other components, so this runs the general
+// path a hair from the unstable equilibrium, where k' ~ 1e-17 and the elliptic integrals grow
+// like log(1/k') ≈ 40; their round-off allows a few 1e-14 rad, hence 5e-14.
 TEST(FreeRotationExact, SteadySpinAboutPrincipalAxes) {
   const Vec3 inertia(2.0, 1.0, 3.0);
   const Mat3 R0 = some_rotation(0.5, -0.3, 1.2);
@@ -252,7 +255,9 @@ TEST(FreeRotationExact, SteadySpinAboutPrincipalAxes) {
     const double t = 2.3;
     const Mat3 expected = R0 * axis_rotation(axis, t * m[axis] / inertia[axis]);
     const Mat3 got = free_rotation_exact(inertia, R0, R0 * m, t);
-    EXPECT_LT(rotation_angle_between(expected, got), 1e-14) << "axis " << axis;
+    const double error = rotation_angle_between(expected, got);
+    report("steady_spin_axis_" + std::to_string(axis) + "_rad", error);
+    EXPECT_LT(error, 5e-14) << "axis " << axis;
   }
 }
 
