@@ -2,10 +2,11 @@
 // body activity counts, and short error toasts. Also keeps the statistics it shows.
 import { Activity } from './protocol.js';
 
-/** Wall-clock window over which frame rates are measured, ms. */
+/** Wall-clock window over which the drawing rate is measured, ms. */
 const kRateWindowMs = 1000;
-/** Longer window for the measured real-time factor: frames arrive in bursts on a busy page. */
-const kRtfWindowMs = 3000;
+/** Longer window for the received frames and the measured real-time factor: frames arrive in
+ *  bursts on a busy page. */
+const kFrameWindowMs = 3000;
 /** HUD text refresh interval, ms. */
 const kRefreshMs = 200;
 
@@ -78,7 +79,7 @@ export class Hud {
     }
     this.counts = { awake: frame.count - asleep - frozen, asleep, frozen };
     this.frameSamples.push([now, frame.time]);
-    trim(this.frameSamples, now, (s) => s[0], kRtfWindowMs);
+    trim(this.frameSamples, now, (s) => s[0], kFrameWindowMs);
   }
 
   /** Records an animation frame at wall time `now` (ms) and refreshes the text now and then. */
@@ -97,8 +98,9 @@ export class Hud {
   get streamFps() {
     const now = performance.now();
     let n = 0;
-    for (const [wall] of this.frameSamples) if (now - wall <= kRateWindowMs) n++;
-    return (n * 1000) / kRateWindowMs;
+    for (const [wall] of this.frameSamples) if (now - wall <= kFrameWindowMs) n++;
+    const span = this.frameSamples.length ? Math.min(kFrameWindowMs, Math.max(kRateWindowMs, now - this.frameSamples[0][0])) : kFrameWindowMs;
+    return (n * 1000) / span;
   }
 
   /**

@@ -6,10 +6,19 @@ import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
 import { sceneIntegrator, sceneName } from './protocol.js';
 
-const viewer = new Viewer(document.getElementById('stage'));
+const viewer = createViewer();
 const hud = new Hud(document.getElementById('hud'), document.getElementById('toasts'));
 const plot = new EnergyPlot(document.getElementById('plot'), document.getElementById('energy'));
 const controls = new Controls(viewer, hud);
+
+function createViewer() {
+  try {
+    return new Viewer(document.getElementById('stage'));
+  } catch (error) {
+    document.getElementById('banner').textContent = `This viewer needs WebGL: ${error.message}`;
+    throw error;
+  }
+}
 
 let currentScene = null; // name of the scene the meshes were built for
 let latestFrame = null;  // newest frame not drawn yet (older ones are simply superseded)

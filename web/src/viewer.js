@@ -127,7 +127,7 @@ export class Viewer {
     sun.shadow.radius = 4;
     sun.shadow.bias = -0.0004;
     sun.shadow.normalBias = 0.02;
-    this.sunDirection = new THREE.Vector3(0.45, 1, 0.3).normalize();
+    this.sunDirection = new THREE.Vector3(0.7, 1, 0.4).normalize();
     this.sun = sun;
     this.scene.add(sun, sun.target);
     this.#fitShadow(new THREE.Vector3(0, 1, 0), 6);
@@ -320,7 +320,7 @@ export class Viewer {
     const radius = Math.max(sphere.radius, 2);
     const halfFov = THREE.MathUtils.degToRad(this.camera.fov / 2);
     const fit = Math.min(halfFov, Math.atan(Math.tan(halfFov) * this.camera.aspect));
-    const distance = (radius / Math.sin(fit)) * 1.05;
+    const distance = (radius / Math.sin(fit)) * 1.25;
     // Aim a little below the centre: the overlays sit at the screen's corners and bottom.
     const target = sphere.center.clone();
     target.y -= radius * 0.12;
