@@ -70,6 +70,28 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
   return target;
 }
 
+/// x = K⁺ b for a symmetric positive semi-definite K: direct for one or two contacts (the
+/// common corner and edge impacts), through the eigendecomposition otherwise, dropping
+/// eigenvalues below 1e-12 of the largest (the null space of a flat face's four contacts).
+PointVector pseudo_solve(const PointMatrix& K, const PointVector& b) {
+  const Eigen::Index m = K.rows();
+  if (m == 1) return PointVector::Constant(1, b(0) / K(0, 0));
+  if (m == 2) {
+    const double det = K(0, 0) * K(1, 1) - K(0, 1) * K(1, 0);
+    if (det > 1e-12 * K(0, 0) * K(1, 1)) {
+      PointVector x(2);
+      x << (K(1, 1) * b(0) - K(0, 1) * b(1)) / det, (K(0, 0) * b(1) - K(1, 0) * b(0)) / det;
+      return x;
+    }
+  }
+  Eigen::SelfAdjointEigenSolver<PointMatrix> eig(K);
+  const PointVector lambda = eig.eigenvalues();
+  const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
+  PointVector y = eig.eigenvectors().transpose() * b;
+  for (Eigen::Index a = 0; a < m; ++a) y(a) = std::abs(lambda(a)) > cutoff ? y(a) / lambda(a) : 0.0;
+  return eig.eigenvectors() * y;
+}
+
 // Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
 // dynamic simulation of non-penetrating rigid bodies", §4, with equality targets).
 // Every active contact i leaves with v⁺ₙ = targetᵢ and a non-negative impulse; a contact
@@ -104,12 +126,7 @@ Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, const 
         b(a) = target[idx[a]] - vn(idx[a]);
         for (int c = 0; c < m; ++c) Ka(a, c) = K(idx[a], idx[c]);
       }
-      Eigen::SelfAdjointEigenSolver<PointMatrix> eig(Ka);
-      const PointVector lambda = eig.eigenvalues();
-      const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-      PointVector y = eig.eigenvectors().transpose() * b;
-      for (int a = 0; a < m; ++a) y(a) = std::abs(lambda(a)) > cutoff ? y(a) / lambda(a) : 0.0;
-      const PointVector ja = eig.eigenvectors() * y;
+      const PointVector ja = pseudo_solve(Ka, b);
       for (int a = 0; a < m; ++a) impulse(idx[a]) = ja(a);
     }
     // Drop the most negative impulse, else add the most violated passive contact.
@@ -305,6 +322,12 @@ int resolve_floor_impact(BodyState& s, const BodyConstants& c, double floor_heig
   const ContactSet set = touching_vertices(s, c, limit);
   const Impulses target = normal_targets(kinematics_of(s, c), set, restitution, rest_speed_ms);
   return resolve(s, c, set, target, friction);
+}
+
+bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_height) {
+  if (!s.P.isZero() || !s.L.isZero()) return false;
+  if (lowest_vertex_y(s, c) < floor_height - kSlop) return false;
+  return touching_vertices(s, c, floor_height + kSimultaneous).count >= 3;
 }
 
 FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {

@@ -23,6 +23,10 @@ inline double lowest_vertex_y(const BodyState& s, const BodyConstants& c) {
 /// ends the Zeno series. Perfectly elastic bodies (e = 1) keep bouncing down to 1e-6 m/s.
 double rest_speed(double restitution, const Vec3& gravity, double dt);
 
+/// True when the body is still (P = L = 0) with a whole face on the floor (three or more
+/// vertices within 1e-9 m of it, none below): statically at rest, so it may start asleep.
+bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_height);
+
 /// Advances one awake body by dt: flight with the world's integrator, impacts located by
 /// the world's TOI method and answered with impulses, resting contact without sinking.
 FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt);
