@@ -70,27 +70,52 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
   return target;
 }
 
-/// x = K⁺ b for a symmetric positive semi-definite K: direct for one or two contacts (the
-/// common corner and edge impacts), through the eigendecomposition otherwise, dropping
-/// eigenvalues below 1e-12 of the largest (the null space of a flat face's four contacts).
-PointVector pseudo_solve(const PointMatrix& K, const PointVector& b) {
+/// K⁺ of a symmetric positive semi-definite K, dropping eigenvalues below 1e-12 of the
+/// largest (the null space of a flat face's four contacts).
+PointMatrix pseudo_inverse(const PointMatrix& K) {
   const Eigen::Index m = K.rows();
-  if (m == 1) return PointVector::Constant(1, b(0) / K(0, 0));
-  if (m == 2) {
-    const double det = K(0, 0) * K(1, 1) - K(0, 1) * K(1, 0);
-    if (det > 1e-12 * K(0, 0) * K(1, 1)) {
-      PointVector x(2);
-      x << (K(1, 1) * b(0) - K(0, 1) * b(1)) / det, (K(0, 0) * b(1) - K(1, 0) * b(0)) / det;
-      return x;
-    }
-  }
+  if (m == 1) return PointMatrix::Constant(1, 1, 1.0 / K(0, 0));
   Eigen::SelfAdjointEigenSolver<PointMatrix> eig(K);
   const PointVector lambda = eig.eigenvalues();
   const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-  PointVector y = eig.eigenvectors().transpose() * b;
-  for (Eigen::Index a = 0; a < m; ++a) y(a) = std::abs(lambda(a)) > cutoff ? y(a) / lambda(a) : 0.0;
-  return eig.eigenvectors() * y;
+  PointVector inv(m);
+  for (Eigen::Index a = 0; a < m; ++a) inv(a) = std::abs(lambda(a)) > cutoff ? 1.0 / lambda(a) : 0.0;
+  return eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
 }
+
+/// The contacts' normal-impulse matrix K (Kᵢⱼ = normal velocity change at i per unit impulse
+/// at j) with the pseudo-inverses of the active subsets met so far: within one impulse
+/// exchange I⁻¹ is fixed, so the friction rounds that re-solve the normals reuse them.
+class NormalSystem {
+ public:
+  NormalSystem(const Kinematics& k, const ContactSet& set) : n_(set.count), K_(n_, n_) {
+    const Vec3 up = Vec3::UnitY();
+    for (int i = 0; i < n_; ++i)
+      for (int j = 0; j < n_; ++j)
+        K_(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
+  }
+  const PointMatrix& K() const { return K_; }
+  /// K⁺ restricted to the contacts in `mask` (bit i = contact i), listed in idx[0..m).
+  const PointMatrix& inverse(unsigned mask, const std::array<int, kMaxPoints>& idx, int m) {
+    for (int c = 0; c < cached_; ++c)
+      if (masks_[c] == mask) return inverses_[c];
+    PointMatrix Ka(m, m);
+    for (int a = 0; a < m; ++a)
+      for (int b = 0; b < m; ++b) Ka(a, b) = K_(idx[a], idx[b]);
+    const int slot = cached_ < kCache ? cached_++ : (next_++ % kCache);
+    masks_[slot] = mask;
+    inverses_[slot] = pseudo_inverse(Ka);
+    return inverses_[slot];
+  }
+
+ private:
+  static constexpr int kCache = 4;
+  int n_;
+  PointMatrix K_;
+  int cached_ = 0, next_ = 0;
+  std::array<unsigned, kCache> masks_{};
+  std::array<PointMatrix, kCache> inverses_;
+};
 
 // Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
 // dynamic simulation of non-penetrating rigid bodies", §4, with equality targets).
@@ -100,33 +125,27 @@ PointVector pseudo_solve(const PointMatrix& K, const PointVector& b) {
 // uses the pseudo-inverse; rigid-body targets are then consistent and a flat landing stays
 // flat. With e = 1 every active contact reverses its normal velocity, which conserves kinetic
 // energy exactly: ΔT = Σ jᵢ (v⁻ᵢ + v⁺ᵢ)/2 = 0.
-Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, const Impulses& target) {
+Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, NormalSystem& system,
+                      const Impulses& target) {
   const int n = set.count;
-  PointMatrix K(n, n);
+  const PointMatrix& K = system.K();
   PointVector vn(n);
   const Vec3 up = Vec3::UnitY();
-  for (int i = 0; i < n; ++i) {
-    vn(i) = k.point_velocity(set.r[i]).y();
-    for (int j = 0; j < n; ++j)
-      K(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
-  }
+  for (int i = 0; i < n; ++i) vn(i) = k.point_velocity(set.r[i]).y();
   std::array<bool, kMaxPoints> active{};
   for (int i = 0; i < n; ++i) active[i] = vn(i) < target[i] - 1e-15;
   PointVector impulse = PointVector::Zero(n);
   for (int iter = 0; iter < 4 * kMaxPoints; ++iter) {
     std::array<int, kMaxPoints> idx{};
     int m = 0;
+    unsigned mask = 0;
     for (int i = 0; i < n; ++i)
-      if (active[i]) idx[m++] = i;
+      if (active[i]) idx[m++] = i, mask |= 1u << i;
     impulse.setZero();
     if (m > 0) {
-      PointMatrix Ka(m, m);
       PointVector b(m);
-      for (int a = 0; a < m; ++a) {
-        b(a) = target[idx[a]] - vn(idx[a]);
-        for (int c = 0; c < m; ++c) Ka(a, c) = K(idx[a], idx[c]);
-      }
-      const PointVector ja = pseudo_solve(Ka, b);
+      for (int a = 0; a < m; ++a) b(a) = target[idx[a]] - vn(idx[a]);
+      const PointVector ja = system.inverse(mask, idx, m) * b;
       for (int a = 0; a < m; ++a) impulse(idx[a]) = ja(a);
     }
     // Drop the most negative impulse, else add the most violated passive contact.
@@ -176,7 +195,8 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   const BodyState s0 = s;
   const Kinematics k0 = kinematics_of(s, c);
   Kinematics k = k0;
-  Impulses normal = solve_normal(s, k, set, target);
+  NormalSystem system(k0, set);
+  Impulses normal = solve_normal(s, k, set, system, target);
   if (mu <= 0.0) return set.count;
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
   double twist = 0.0;  // torsional impulse about the normal, N·m·s
@@ -213,7 +233,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
     k.apply(s, centroid, Vec3(friction.x(), 0.0, friction.y()));
     s.L += twist * up;
     k.w += k.inv_inertia * (twist * up);
-    normal = solve_normal(s, k, set, target);
+    normal = solve_normal(s, k, set, system, target);
     if (settled) break;
   }
   return set.count;
