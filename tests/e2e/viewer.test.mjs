@@ -107,7 +107,7 @@ async function getJson(base, route) {
 
 const hudTime = async (page) => parseFloat(await page.locator('#hud-time').textContent());
 
-test('viewer: renders the box, HUD time runs, pause stops it, click kicks the box, reconnects after a restart',
+test('viewer against the real server: pixels, HUD, pause, step, click-kick, reconnect, scene menu, phone tap',
   { timeout: 88000 }, async (t) => {
     if (!fs.existsSync(kServer)) {
       t.skip(`no server binary at ${kServer} (build it, or set TUMBLE_SERVER)`);
@@ -132,7 +132,7 @@ test('viewer: renders the box, HUD time runs, pause stops it, click kicks the bo
     });
 
     context = await chromium.launchPersistentContext(userData, {
-      executablePath: kChromium, headless: true, args: kChromiumArgs, viewport: kViewport,
+      executablePath: kChromium, headless: true, args: kChromiumArgs, viewport: kViewport, hasTouch: true,
     });
     const page = context.pages()[0] ?? await context.newPage();
     page.setDefaultTimeout(15000);
@@ -259,6 +259,26 @@ test('viewer: renders the box, HUD time runs, pause stops it, click kicks the bo
       await until(`the page to show ${other} with ${expected} bodies`,
         () => page.evaluate(([name, n]) => window.tumble.scene === name && window.tumble.bodies === n, [other, expected]));
       assert.ok(count >= 1);
+    });
+
+    await t.test('on a phone-sized screen the overlays fit and a tap kicks a box', async () => {
+      await page.setViewportSize({ width: 390, height: 760 });
+      assert.ok((await fetch(`${base}api/pause`, { method: 'POST' })).ok);
+      await until('the page to show paused', () => page.evaluate(() => window.tumble.paused));
+      for (const id of ['hud', 'plot-card', 'panel']) {
+        const box = await page.locator(`#${id}`).boundingBox();
+        assert.ok(box && box.x >= 0 && box.x + box.width <= 390 + 0.5, `#${id} fits the 390 px width (${JSON.stringify(box)})`);
+      }
+      const index = 0;
+      const target = await page.evaluate((i) => window.tumble.bodyScreenPosition(i), index);
+      assert.ok(target?.visible, 'a body is in view');
+      const before = (await getJson(base, 'state')).bodies[index];
+      await page.touchscreen.tap(target.x, target.y);
+      await until('the tap to change the body velocity', async () => {
+        const body = (await getJson(base, 'state')).bodies[index];
+        return Math.hypot(...body.velocity.map((v, k) => v - before.velocity[k])) > 0.5;
+      }, 10000);
+      await snap('5-phone');
     });
 
     assert.deepEqual(pageErrors, [], 'no uncaught errors in the page');

@@ -27,7 +27,7 @@ export class EnergyPlot {
       cursor: { show: false },
       scales: { x: { time: false } },
       axes: [
-        { ...axisStyle, size: 22, values: (u, ticks) => ticks.map((t) => `${t.toFixed(0)} s`) },
+        { ...axisStyle, size: 22, values: (u, ticks, axis, space, step) => ticks.map((t) => `${t.toFixed(decimalsFor(step))} s`) },
         { ...axisStyle, size: 58, values: (u, ticks) => ticks.map(formatJoules) },
       ],
       series: [{}, { label: 'E', stroke: '#f0a04b', width: 1.5, points: { show: false } }],
@@ -85,6 +85,11 @@ export class EnergyPlot {
     }
     this.readout.textContent = `E ${formatJoules(e)}  ΔE ${drift >= 0 ? '+' : ''}${formatJoules(drift)}${relative}`;
   }
+}
+
+/** Decimals that tell apart ticks `step` apart (0 for whole seconds, 1 for 0.5 s, …). */
+function decimalsFor(step) {
+  return step > 0 && step < 1 ? Math.min(6, Math.ceil(-Math.log10(step) - 1e-9)) : 0;
 }
 
 function formatJoules(value) {
