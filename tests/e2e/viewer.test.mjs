@@ -105,7 +105,8 @@ async function getJson(base, route) {
   return response.json();
 }
 
-const hudTime = async (page) => parseFloat(await page.locator('#hud-time').textContent());
+const hudTime = async (page) => parseFloat(await page.evaluate(() => document.getElementById('hud-time').textContent));
+const hudText = (page) => page.evaluate(() => document.getElementById('hud').innerText);
 
 test('viewer against the real server: pixels, HUD, pause, step, click-kick, reconnect, scene menu, phone tap',
   { timeout: 88000 }, async (t) => {
@@ -162,7 +163,7 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
     await t.test('the HUD sim time advances', async () => {
       const t0 = await hudTime(page);
       await until('the HUD sim time to advance by 0.3 s', async () => (await hudTime(page)) > t0 + 0.3);
-      const text = await page.locator('#hud').innerText();
+      const text = await hudText(page);
       assert.match(text, /live/, 'HUD shows the connection as live');
       assert.match(text, /fps/);
       assert.match(text, /dropped frames/);
@@ -172,7 +173,7 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
     await t.test('the Pause button stops the simulation', async () => {
       await page.getByRole('button', { name: 'Pause', exact: true }).click();
       await until('the server to report paused', async () => (await getJson(base, 'state')).paused === true);
-      await until('the HUD to show paused', async () => (await page.locator('#hud').innerText()).includes('paused'));
+      await until('the HUD to show paused', async () => (await hudText(page)).includes('paused'));
       await until('the button to read Resume', () => page.getByRole('button', { name: 'Resume', exact: true }).isVisible());
       const h0 = await hudTime(page);
       const s0 = (await getJson(base, 'state')).time;
@@ -229,7 +230,7 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
       const port = server.port;
       await stopServer(server.child);
       await until('the page to notice the lost connection', () => page.evaluate(() => !window.tumble.connected), 10000);
-      await until('the HUD to say reconnecting', async () => (await page.locator('#hud').innerText()).includes('reconnecting'));
+      await until('the HUD to say reconnecting', async () => (await hudText(page)).includes('reconnecting'));
       server = await startServer(port);
       await until('the page to reconnect', () => page.evaluate(() => window.tumble.connected && window.tumble.connects >= 2), 20000);
       const frames = await page.evaluate(() => window.tumble.frames);
@@ -265,9 +266,12 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
       await page.setViewportSize({ width: 390, height: 760 });
       assert.ok((await fetch(`${base}api/pause`, { method: 'POST' })).ok);
       await until('the page to show paused', () => page.evaluate(() => window.tumble.paused));
-      for (const id of ['hud', 'plot-card', 'panel']) {
-        const box = await page.locator(`#${id}`).boundingBox();
-        assert.ok(box && box.x >= 0 && box.x + box.width <= 390 + 0.5, `#${id} fits the 390 px width (${JSON.stringify(box)})`);
+      const boxes = await page.evaluate(() => ['hud', 'plot-card', 'panel'].map((id) => {
+        const r = document.getElementById(id).getBoundingClientRect();
+        return { id, left: r.left, right: r.right };
+      }));
+      for (const { id, left, right } of boxes) {
+        assert.ok(left >= 0 && right <= 390.5, `#${id} fits the 390 px width (${left}..${right})`);
       }
       const index = 0;
       const target = await page.evaluate((i) => window.tumble.bodyScreenPosition(i), index);
