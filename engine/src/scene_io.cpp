@@ -31,8 +31,9 @@ std::string text(const json& j, const std::string& field) {
 
 void refuse_unknown_keys(const json& j, const std::string& at,
                          std::initializer_list<const char*> known) {
-  for (const auto& [key, value] : j.items()) {
-    if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; }))
+  for (const auto& item : j.items()) {
+    const std::string& key = item.key();
+    if (std::none_of(known.begin(), known.end(), [&key](const char* k) { return key == k; }))
       fail(at.empty() ? key : at + "." + key, "unknown field");
   }
 }
