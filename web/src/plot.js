@@ -27,7 +27,7 @@ export class EnergyPlot {
       cursor: { show: false },
       scales: { x: { time: false } },
       axes: [
-        { ...axisStyle, size: 22, values: (u, ticks, axis, space, step) => ticks.map((t) => `${t.toFixed(decimalsFor(step))} s`) },
+        { ...axisStyle, size: 26, values: (u, ticks, axis, space, step) => ticks.map((t) => `${t.toFixed(decimalsFor(step))} s`) },
         { ...axisStyle, size: 58, values: (u, ticks) => ticks.map(formatJoules) },
       ],
       series: [{}, { label: 'E', stroke: '#f0a04b', width: 1.5, points: { show: false } }],
