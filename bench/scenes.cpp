@@ -38,7 +38,9 @@ tumble::Scene empty_floor_scene(const std::string& name, double dt) {
 
 }  // namespace
 
-tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed) {
+const char* to_string(BoxShape shape) { return shape == BoxShape::cube ? "cube" : "box"; }
+
+tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed, BoxShape shape) {
   tumble::Scene s = empty_floor_scene("separated_boxes", dt);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> size(0.2, 0.6), mass(1.0, 10.0), height(1.0, 3.0),
@@ -50,6 +52,7 @@ tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed) {
     tumble::BodyDef b;
     b.name = "box" + std::to_string(i);
     b.size = {size(rng), size(rng), size(rng)};
+    if (shape == BoxShape::cube) b.size = Vec3::Constant(b.size.x());
     b.mass = mass(rng);
     b.position = {kSpacing * static_cast<double>(i % side), height(rng),
                   kSpacing * static_cast<double>(i / side)};

@@ -17,11 +17,19 @@ tumble::Scene bundled(const std::string& name);
 tumble::Scene with(tumble::Scene s, tumble::Integrator integrator, tumble::ToiMethod toi,
                    double dt);
 
-/// N well-separated boxes (random size 0.2–0.6 m, mass 1–10 kg, pose, spin up to 3 rad/s,
-/// drop height 1–3 m, fixed seed) on a 1.5 m grid over a frictionless floor with e = 0.5.
-/// Frictionless: the floor pushes only vertically, so centres never move sideways and the
-/// boxes stay separated (Tumble has box–floor contact only).
-tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed = 42);
+/// Shape of the bodies of separated_boxes: cubes (one edge length each; Tumble turns them in
+/// closed form) or general boxes (three edge lengths; `exact` runs Jacobi elliptic functions).
+enum class BoxShape { cube, general };
+
+/// "cube" / "box".
+const char* to_string(BoxShape shape);
+
+/// N well-separated boxes (random size 0.2–0.6 m per edge, or one edge for cubes; mass
+/// 1–10 kg, pose, spin up to 3 rad/s, drop height 1–3 m, fixed seed) on a 1.5 m grid over a
+/// frictionless floor with e = 0.5. Frictionless: the floor pushes only vertically, so centres
+/// never move sideways and the boxes stay separated.
+tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed = 42,
+                              BoxShape shape = BoxShape::general);
 
 /// `resting` unit cubes placed on the floor at rest plus `falling` ones dropped from 2 m with
 /// spin, all separated; frictionless floor with e = 0.5, dt = 1/60 s.

@@ -2,6 +2,7 @@
 /// turned to face +y), loaded through a temporary file, stepped with mj_step.
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -25,6 +26,18 @@ double damping_ratio_for(double e) {
   return -l / std::sqrt(std::numbers::pi * std::numbers::pi + l * l);
 }
 
+/// Contact time constant, s, for damping ratio zeta: max(0.02 s, 2·dt/ζ).
+/// MuJoCo's documented rule is timeconst ≥ 2·timestep (default 0.02 s), and MuJoCo 2.2 already
+/// enforces it (the `refsafe` flag, on by default), so it alone does not change anything: the
+/// `bounce` cube still went to 5.4 m at dt = 1/60. The cause is the stiffness MuJoCo derives,
+/// k = 1/(dmax²·τ²·ζ²): with ζ = 0.215 (e = 0.5) the contact oscillates at
+/// ω₀ = 1/(dmax·τ·ζ) ≈ 147 rad/s, ω₀·dt ≈ 2.4 > 2, beyond what the semi-implicit Euler step
+/// resolves, and the box gains energy. Applying the rule to the oscillation, τ·ζ ≥ 2·dt,
+/// resolves it (apex 0.233 m against 0.25 m) and reduces to MuJoCo's rule for ζ = 1.
+double contact_time_constant(double dt, double zeta) {
+  return std::max(0.02, 2.0 * dt / std::max(zeta, 0.05));  // e → 1 makes ζ → 0
+}
+
 /// A box on a plane makes at most 4 contacts; MuJoCo 2.2 sizes mjData from these at load.
 std::size_t contact_capacity(std::size_t bodies) { return 4 * bodies + 16; }
 /// Constraint rows: 1 per frictionless contact, 4 per pyramidal condim-3 contact.
@@ -39,6 +52,7 @@ std::string mjcf(const PeerScene& scene, bool rk4) {
   const bool frictionless = scene.friction <= 0.0;
   const int condim = frictionless ? 1 : 3;
   const double mu = frictionless ? 0.0 : scene.friction;
+  const double zeta = damping_ratio_for(scene.restitution);
   x << "<mujoco model=\"tumble_bench\">\n"
     << "  <compiler angle=\"radian\" inertiafromgeom=\"true\"/>\n"
     << "  <option timestep=\"" << scene.dt << "\" gravity=\"" << scene.gravity.x() << ' '
@@ -47,7 +61,7 @@ std::string mjcf(const PeerScene& scene, bool rk4) {
     << "  <size nconmax=\"" << contact_capacity(n) << "\" njmax=\""
     << constraint_rows(n, condim) << "\"/>\n"
     << "  <default><geom condim=\"" << condim << "\" friction=\"" << mu
-    << " 0.005 0.0001\" solref=\"0.02 " << damping_ratio_for(scene.restitution)
+    << " 0.005 0.0001\" solref=\"" << contact_time_constant(scene.dt, zeta) << ' ' << zeta
     << "\"/></default>\n"
     << "  <worldbody>\n";
   if (scene.floor) x << "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\" zaxis=\"0 1 0\"/>\n";
@@ -79,8 +93,22 @@ class MujocoWorld final : public PeerWorld {
   MujocoWorld(const PeerScene& scene, bool rk4) {
     const double gb = mujoco_dense_bytes(scene) / 1e9;
     if (gb > kMaxGigabytes) {
-      throw std::runtime_error("MuJoCo 2.2 would allocate " + std::to_string(gb) +
-                               " GB of dense constraint arrays (njmax × nv and njmax²)");
+      // <size njmax> cannot be lowered to fit: once the boxes land, every one of them holds
+      // up to 4 floor contacts, and rows beyond njmax do not fit (MuJoCo warns
+      // mjWARN_CNSTRFULL and drops constraints), so it would no longer be the same
+      // simulation. The arena that removes this limit (<size memory>) arrived in MuJoCo 2.3.
+      char buf[600];
+      std::snprintf(buf, sizeof buf,
+                    "MuJoCo 2.2 allocates efc_J (njmax × nv) and efc_AR (njmax × njmax) densely "
+                    "in mjData; the scene needs njmax ≥ %zu constraint rows (4 floor contacts "
+                    "per box once they land) with nv = %zu, i.e. %.0f GB, so it was not built "
+                    "(limit %.0f GB on this shared machine); a smaller njmax in <size> is no way "
+                    "out: the rows of the landed boxes would not fit (MuJoCo warns "
+                    "mjWARN_CNSTRFULL and drops constraints), so it would not be the same "
+                    "simulation; MuJoCo 2.3 replaced these arrays with an arena (<size memory>)",
+                    constraint_rows(scene.boxes.size(), scene.friction <= 0.0 ? 1 : 3),
+                    6 * scene.boxes.size(), gb, kMaxGigabytes);
+      throw std::runtime_error(buf);
     }
     static std::atomic<int> counter{0};
     const std::filesystem::path path =
