@@ -53,6 +53,8 @@ json parse_body(const Request& req) {
     j = json::parse(body);
   } catch (const json::parse_error& e) {
     throw Refusal{400, std::string("malformed JSON: ") + e.what(), ""};
+  } catch (const json::exception& e) {  // e.g. 1e999: a number that is not finite as a double
+    throw Refusal{400, std::string("invalid JSON number: ") + e.what(), ""};
   }
   if (!j.is_object()) throw Refusal{400, "the request body must be a JSON object", ""};
   return j;
@@ -139,9 +141,9 @@ void post_step(const Request& req, ServerContext& ctx, const Reply& reply) {
   only_keys(body, {"steps"});
   const json& steps = required(body, "steps");
   if (!steps.is_number_integer()) throw Refusal{400, "steps must be an integer", "steps"};
-  const std::int64_t n = steps.get<std::int64_t>();
-  if (steps.is_number_unsigned() ? steps.get<std::uint64_t>() > 100000 : (n < 1 || n > 100000))
-    throw Refusal{400, "steps must be in 1..100000", "steps"};
+  const bool huge = steps.is_number_unsigned() && steps.get<std::uint64_t>() > 100000;
+  const std::int64_t n = huge ? 0 : steps.get<std::int64_t>();
+  if (n < 1 || n > 100000) throw Refusal{400, "steps must be in 1..100000", "steps"};
   submit(ctx, req, StepCommand{static_cast<std::uint32_t>(n)}, reply);
 }
 

@@ -1,0 +1,93 @@
+#include "options.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <vector>
+
+namespace tumble::server {
+namespace {
+
+ParsedOptions parse(std::vector<const char*> args) {
+  args.insert(args.begin(), "tumble-server");
+  return parse_options(static_cast<int>(args.size()), args.data());
+}
+
+// Sets an environment variable for the lifetime of the object.
+struct EnvVar {
+  EnvVar(const char* name, const char* value) : name(name) { setenv(name, value, 1); }
+  ~EnvVar() { unsetenv(name); }
+  const char* name;
+};
+
+TEST(Options, Defaults) {
+  const ParsedOptions p = parse({});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_EQ(p.options->scene, "seed");
+  EXPECT_EQ(p.options->port, 8080);
+  EXPECT_EQ(p.options->bind, "127.0.0.1");
+  EXPECT_EQ(p.options->render_ms, 20);
+  EXPECT_EQ(p.options->threads, 2);
+  EXPECT_EQ(p.options->max_viewers, 64);
+  EXPECT_EQ(p.options->token, "");
+  EXPECT_EQ(p.options->web_root, default_web_root());
+}
+
+TEST(Options, CommandLine) {
+  const ParsedOptions p = parse({"--scene", "bounce", "--port", "9000", "--bind", "0.0.0.0",
+                                 "--render-ms", "10", "--threads", "3", "--token", "t0k",
+                                 "--max-viewers", "5", "--allowed-origin", "http://x:1",
+                                 "--web-root", "/tmp"});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_EQ(p.options->scene, "bounce");
+  EXPECT_EQ(p.options->port, 9000);
+  EXPECT_EQ(p.options->bind, "0.0.0.0");
+  EXPECT_EQ(p.options->render_ms, 10);
+  EXPECT_EQ(p.options->threads, 3);
+  EXPECT_EQ(p.options->token, "t0k");
+  EXPECT_EQ(p.options->max_viewers, 5);
+  EXPECT_EQ(p.options->allowed_origin, "http://x:1");
+  EXPECT_EQ(p.options->web_root, "/tmp");
+}
+
+TEST(Options, EnvironmentAndCommandLineWins) {
+  EnvVar port("TUMBLE_PORT", "9100");
+  EnvVar scene("TUMBLE_SCENE", "many");
+  EnvVar render("TUMBLE_RENDER_MS", "40");
+  EnvVar viewers("TUMBLE_MAX_VIEWERS", "7");
+  EnvVar unrelated("TUMBLE_SCENES_DIR", "/nowhere");  // The engine's, not an option.
+  ParsedOptions p = parse({});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_EQ(p.options->port, 9100);
+  EXPECT_EQ(p.options->scene, "many");
+  EXPECT_EQ(p.options->render_ms, 40);
+  EXPECT_EQ(p.options->max_viewers, 7);
+  p = parse({"--port", "9200"});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_EQ(p.options->port, 9200);
+  EXPECT_EQ(p.options->scene, "many");
+}
+
+TEST(Options, BadInputExitsWithTwo) {
+  for (const auto& args : std::vector<std::vector<const char*>>{
+           {"--port", "70000"}, {"--port", "abc"}, {"--bogus"}, {"--render-ms", "0"},
+           {"--threads", "0"}, {"--bind", "not-an-address"}, {"--max-viewers", "-1"},
+           {"--port"}}) {
+    const ParsedOptions p = parse(args);
+    EXPECT_FALSE(p.options) << args[0];
+    EXPECT_EQ(p.exit_code, 2) << args[0];
+    EXPECT_NE(p.message.find("Usage"), std::string::npos);
+  }
+  EnvVar port("TUMBLE_PORT", "x");
+  EXPECT_EQ(parse({}).exit_code, 2);
+}
+
+TEST(Options, HelpExitsWithZero) {
+  const ParsedOptions p = parse({"--help"});
+  EXPECT_FALSE(p.options);
+  EXPECT_EQ(p.exit_code, 0);
+  EXPECT_NE(p.message.find("--render-ms"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace tumble::server
