@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "contact_stage.hpp"
 #include "floor_contact.hpp"
 #include "integrators.hpp"
 
@@ -60,7 +61,27 @@ World::World(Scene scene) : scene_(std::move(scene)) {
     if (w.floor && rests_on_face(b.s, b.c, w.floor->height)) b.activity = Activity::asleep;
     bodies_.push_back(b);
   }
+  contact_ = std::make_unique<ContactState>();
+  init_contact_state(*contact_, bodies_.size());
 }
+
+World::World(const World& other)
+    : scene_(other.scene_),
+      bodies_(other.bodies_),
+      time_(other.time_),
+      steps_(other.steps_),
+      total_impacts_(other.total_impacts_),
+      last_(other.last_),
+      contact_(std::make_unique<ContactState>(*other.contact_)) {}
+
+World& World::operator=(const World& other) {
+  if (this != &other) *this = World(other);
+  return *this;
+}
+
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+World::~World() = default;
 
 void World::step() { step(scene_.world.dt); }
 
@@ -69,8 +90,12 @@ void World::step(double dt) {
   last_ = {};
   const WorldDef& w = scene_.world;
   const bool renormalize = (steps_ + 1) % kGramSchmidtInterval == 0;
-  for (Body& b : bodies_) {
-    if (b.activity != Activity::awake) continue;
+  // Body–body contact runs only when two bodies can touch; otherwise every body takes the
+  // floor-only path below, bit for bit as without it.
+  const bool contacts = find_contacts(*contact_, bodies_, w, dt, last_);
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    Body& b = bodies_[i];
+    if (b.activity != Activity::awake || contact_->in_solver[i]) continue;
     ++last_.awake;
     const BodyState before = b.s;
     const FloorStepResult r = advance_with_floor(b, w, dt);
@@ -85,7 +110,9 @@ void World::step(double dt) {
     }
     if (renormalize) gram_schmidt(b.s.R);
     update_sleep(b, r.touched, dt);
+    if (b.activity == Activity::asleep) sleep_alone(*contact_, static_cast<std::uint32_t>(i));
   }
+  if (contacts) step_contacts(*contact_, bodies_, w, dt, renormalize, last_);
   total_impacts_ += last_.impacts;
   time_ += dt;
   ++steps_;
@@ -99,8 +126,7 @@ void World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3& point) {
   if (b.activity == Activity::frozen) throw InvalidInput("body is frozen (it went non-finite)");
   b.s.P += impulse;
   b.s.L += (point - b.s.x).cross(impulse);
-  b.activity = Activity::awake;
-  b.still_time = 0.0;
+  wake_island(*contact_, bodies_, id);
 }
 
 void World::apply_impulse(BodyId id, const Vec3& impulse) {

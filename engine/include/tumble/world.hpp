@@ -9,6 +9,7 @@
 /// Not thread-safe: one thread owns a World (the server's simulation thread). No I/O, no
 /// exceptions inside step(); bad input is refused at the entry points.
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -27,7 +28,15 @@ struct StepStats {
   std::uint32_t toi_iterations = 0;  ///< Trajectory evaluations spent finding impacts.
   std::uint32_t awake = 0;           ///< Bodies integrated.
   std::uint32_t newly_frozen = 0;    ///< Bodies that went non-finite this step.
+  std::uint32_t pairs = 0;           ///< Broad-phase pairs whose bounding boxes overlap.
+  std::uint32_t contacts = 0;        ///< Body–body contacts (pairs with manifold points).
+  std::uint32_t contact_points = 0;  ///< Points in those contacts.
+  std::uint32_t islands = 0;         ///< Islands of touching bodies solved together.
+  std::uint32_t solver_bodies = 0;   ///< Bodies stepped by the contact solver.
 };
+
+/// Body–body contact data kept between steps (engine/src/contact_stage.hpp).
+struct ContactState;
 
 /// Thrown by World's entry points for input that names no body or is not finite.
 struct InvalidInput : std::invalid_argument {
@@ -39,6 +48,12 @@ class World {
  public:
   /// Builds the world; throws InvalidInput with the field when validate(scene) fails.
   explicit World(Scene scene);
+  /// Deep copies (the contact cache included) and moves.
+  World(const World& other);
+  World& operator=(const World& other);
+  World(World&&) noexcept;
+  World& operator=(World&&) noexcept;
+  ~World();
 
   /// Advances by the scene's dt.
   void step();
@@ -89,6 +104,7 @@ class World {
   std::uint64_t steps_ = 0;
   std::uint64_t total_impacts_ = 0;
   StepStats last_;
+  std::unique_ptr<ContactState> contact_;  // broad phase, contact cache, islands, sleep groups
 };
 
 }  // namespace tumble

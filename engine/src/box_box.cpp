@@ -1,0 +1,260 @@
+#include "box_box.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tumble {
+namespace {
+
+// A face axis of B (or an edge axis) replaces the best face axis of A only when it separates
+// by this much more (m): near-ties (a box resting flat on another) then keep one reference
+// face from step to step, so feature ids and the warm-started impulses persist.
+constexpr double kFaceTolerance = 1e-4;
+constexpr double kEdgeTolerance = 5e-4;
+constexpr int kMaxClipped = 8;
+// A vertex of the incident face this far outside a side plane of the reference face still
+// counts as inside (m). Equal boxes stacked flush have their vertices exactly on those
+// planes; without the tolerance round-off would flip them between "vertex" and "clipped
+// point" from step to step, changing their ids and losing the warm start.
+constexpr double kClipTolerance = 1e-4;
+
+/// A vertex of the clipped incident face: the incident edges and clip planes it lies on
+/// (4 bits each) identify it from step to step.
+struct ClipVertex {
+  Vec3 p;
+  unsigned edges = 0;
+  unsigned planes = 0;
+};
+
+struct Polygon {
+  int count = 0;
+  std::array<ClipVertex, kMaxClipped> v;
+};
+
+/// Sutherland–Hodgman: keeps the part of `in` where distance(q) ≤ 0 (one side plane of the
+/// reference face).
+template <typename Distance>
+Polygon clip(const Polygon& in, int plane, Distance distance) {
+  Polygon out;
+  for (int i = 0; i < in.count; ++i) {
+    const ClipVertex& a = in.v[(i + in.count - 1) % in.count];
+    const ClipVertex& b = in.v[i];
+    const double da = distance(a.p) - kClipTolerance, db = distance(b.p) - kClipTolerance;
+    if ((da <= 0.0) != (db <= 0.0)) {
+      ClipVertex x;
+      x.p = a.p + (da / (da - db)) * (b.p - a.p);
+      x.edges = a.edges & b.edges;
+      x.planes = (a.planes & b.planes) | (1u << plane);
+      if (out.count < kMaxClipped) out.v[out.count++] = x;
+    }
+    if (db <= 0.0 && out.count < kMaxClipped) out.v[out.count++] = b;
+  }
+  return out;
+}
+
+struct Box {
+  const BodyState& s;
+  const BodyConstants& c;
+};
+
+/// Face–face (or face–edge, face–vertex) case: the incident face of `inc` clipped against the
+/// side planes of the reference face of `ref`; `n_ref` points from ref to inc.
+int clip_faces(const Box& ref, int ref_axis, const Vec3& n_ref, const Box& inc, double margin,
+               std::uint32_t id_base, std::array<ManifoldPoint, kMaxClipped>& out) {
+  const Vec3 ref_center = ref.s.x + ref.c.half_extents(ref_axis) * n_ref;
+  const int ua = (ref_axis + 1) % 3, va = (ref_axis + 2) % 3;
+  const Vec3 u = ref.s.R.col(ua), v = ref.s.R.col(va);
+  const double hu = ref.c.half_extents(ua), hv = ref.c.half_extents(va);
+
+  const Vec3 dots = inc.s.R.transpose() * n_ref;
+  int k = 0;
+  dots.cwiseAbs().maxCoeff(&k);
+  const double side = dots(k) > 0.0 ? -1.0 : 1.0;  // incident face faces the reference
+  const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+  const Vec3 c = inc.s.x + side * inc.c.half_extents(k) * inc.s.R.col(k);
+  const Vec3 e1 = inc.c.half_extents(k1) * inc.s.R.col(k1);
+  const Vec3 e2 = inc.c.half_extents(k2) * inc.s.R.col(k2);
+  Polygon poly;
+  poly.count = 4;
+  const Vec3 corners[4] = {c + e1 + e2, c - e1 + e2, c - e1 - e2, c + e1 - e2};
+  for (int i = 0; i < 4; ++i) {
+    // Vertex i lies on incident edges i (to i+1) and i−1.
+    poly.v[i] = {corners[i], (1u << i) | (1u << ((i + 3) % 4)), 0u};
+  }
+  poly = clip(poly, 0, [&](const Vec3& q) { return (q - ref_center).dot(u) - hu; });
+  poly = clip(poly, 1, [&](const Vec3& q) { return -(q - ref_center).dot(u) - hu; });
+  poly = clip(poly, 2, [&](const Vec3& q) { return (q - ref_center).dot(v) - hv; });
+  poly = clip(poly, 3, [&](const Vec3& q) { return -(q - ref_center).dot(v) - hv; });
+
+  const std::uint32_t inc_face = static_cast<std::uint32_t>(2 * k + (side > 0.0 ? 1 : 0));
+  int n = 0;
+  for (int i = 0; i < poly.count; ++i) {
+    const double depth = (poly.v[i].p - ref_center).dot(n_ref);
+    if (depth >= margin) continue;
+    ManifoldPoint& p = out[n++];
+    p.position = poly.v[i].p - (0.5 * depth) * n_ref;
+    p.separation = depth;
+    p.id = id_base | (inc_face << 8) | (poly.v[i].planes << 4) | poly.v[i].edges;
+  }
+  return n;
+}
+
+/// Chooses 4 of n points: the deepest, the farthest from it, the largest triangle, then the
+/// point farthest outside that triangle's base on the other side (Gregorius, "Robust contact
+/// creation for physics simulations", GDC 2015).
+int reduce_to_four(const std::array<ManifoldPoint, kMaxClipped>& in, int n, const Vec3& normal,
+                   std::array<ManifoldPoint, kMaxManifoldPoints>& out) {
+  if (n <= kMaxManifoldPoints) {
+    std::copy(in.begin(), in.begin() + n, out.begin());
+    return n;
+  }
+  int i0 = 0;
+  for (int i = 1; i < n; ++i)
+    if (in[i].separation < in[i0].separation) i0 = i;
+  int i1 = -1;
+  double best = -1.0;
+  for (int i = 0; i < n; ++i) {
+    const double d = (in[i].position - in[i0].position).squaredNorm();
+    if (i != i0 && d > best) best = d, i1 = i;
+  }
+  auto area = [&](int a, int b, int q) {
+    return (in[b].position - in[a].position).cross(in[q].position - in[a].position).dot(normal);
+  };
+  int i2 = -1;
+  best = -1.0;
+  for (int i = 0; i < n; ++i) {
+    if (i == i0 || i == i1) continue;
+    const double a = std::abs(area(i0, i1, i));
+    if (a > best) best = a, i2 = i;
+  }
+  const double sign2 = area(i0, i1, i2) >= 0.0 ? 1.0 : -1.0;
+  int i3 = -1;
+  best = -INFINITY;
+  for (int i = 0; i < n; ++i) {
+    if (i == i0 || i == i1 || i == i2) continue;
+    // Prefer the point on the far side of i0–i1 from i2; otherwise the one adding most area
+    // to the triangle's other edges.
+    const double a = -sign2 * area(i0, i1, i);
+    const double b = std::max(-sign2 * area(i1, i2, i), -sign2 * area(i2, i0, i));
+    const double score = std::max(a, b);
+    if (score > best) best = score, i3 = i;
+  }
+  out[0] = in[i0];
+  out[1] = in[i1];
+  out[2] = in[i2];
+  out[3] = in[i3];
+  return 4;
+}
+
+}  // namespace
+
+// Separating-axis test for oriented boxes (Gottschalk, Lin & Manocha, "OBBTree", SIGGRAPH
+// 1996; Ericson, Real-Time Collision Detection, §4.4.1): two convex boxes are disjoint iff
+// they are separated along one of 15 axes — the 3 face normals of each and the 9 cross
+// products of their edge directions. The axis of greatest separation (least penetration)
+// names the touching features: a face axis gives a face–face/face–edge/face–vertex contact,
+// found by clipping the most anti-parallel face of the other box against the reference face's
+// side planes (Ericson §5.5; Box2D-lite, Catto GDC 2006); an edge axis gives one point, the
+// closest points of the two edges. Separations are signed, so the same test yields
+// speculative points for boxes up to `margin` apart.
+BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                          const BodyConstants& cb, double margin) {
+  BoxManifold m;
+  const Vec3 d = b.x - a.x;
+  const Mat3 C = a.R.transpose() * b.R;  // C(i,j) = a_i · b_j
+  // ε keeps near-parallel edge pairs from producing a false separating axis (Gottschalk).
+  const Mat3 absC = C.cwiseAbs().array() + 1e-12;
+  const Vec3 da = a.R.transpose() * d;
+  const Vec3 db = b.R.transpose() * d;
+  const Vec3& ha = ca.half_extents;
+  const Vec3& hb = cb.half_extents;
+
+  double best_a = -INFINITY, best_b = -INFINITY;
+  int axis_a = 0, axis_b = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double s = std::abs(da(i)) - (ha(i) + absC.row(i).dot(hb));
+    if (s > margin) return m;
+    if (s > best_a) best_a = s, axis_a = i;
+  }
+  for (int j = 0; j < 3; ++j) {
+    const double s = std::abs(db(j)) - (absC.col(j).dot(ha) + hb(j));
+    if (s > margin) return m;
+    if (s > best_b) best_b = s, axis_b = j;
+  }
+  double best_edge = -INFINITY;
+  int edge_i = -1, edge_j = -1;
+  Vec3 edge_axis = Vec3::Zero();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      Vec3 axis = a.R.col(i).cross(b.R.col(j));
+      const double len = axis.norm();
+      if (len < 1e-6) continue;  // parallel edges: covered by the face axes
+      axis /= len;
+      const double ra = (a.R.transpose() * axis).cwiseAbs().dot(ha);
+      const double rb = (b.R.transpose() * axis).cwiseAbs().dot(hb);
+      const double s = std::abs(d.dot(axis)) - (ra + rb);
+      if (s > margin) return m;
+      if (s > best_edge) best_edge = s, edge_i = i, edge_j = j, edge_axis = axis;
+    }
+  }
+
+  const double best_face = std::max(best_a, best_b);
+  if (edge_i >= 0 && best_edge > best_face + kEdgeTolerance) {
+    Vec3 n = edge_axis;
+    if (n.dot(d) < 0.0) n = -n;
+    // The edge of A farthest along n and the edge of B farthest along −n.
+    Vec3 pa = a.x, pb = b.x;
+    std::uint32_t signs = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (k != edge_i) {
+        const double s = a.R.col(k).dot(n) > 0.0 ? 1.0 : -1.0;
+        pa += s * ha(k) * a.R.col(k);
+        signs |= (s > 0.0 ? 1u : 0u) << k;
+      }
+      if (k != edge_j) {
+        const double s = b.R.col(k).dot(n) < 0.0 ? 1.0 : -1.0;
+        pb += s * hb(k) * b.R.col(k);
+        signs |= (s > 0.0 ? 1u : 0u) << (3 + k);
+      }
+    }
+    // Closest points of the lines pa + s u and pb + t w (Ericson §5.1.8), clamped to the edges.
+    const Vec3 u = a.R.col(edge_i), w = b.R.col(edge_j);
+    const Vec3 r = pa - pb;
+    const double uw = u.dot(w), ur = u.dot(r), wr = w.dot(r);
+    const double denom = 1.0 - uw * uw;
+    double s = denom > 1e-12 ? (uw * wr - ur) / denom : 0.0;
+    s = std::clamp(s, -ha(edge_i), ha(edge_i));
+    double t = std::clamp(wr + s * uw, -hb(edge_j), hb(edge_j));
+    s = std::clamp(t * uw - ur, -ha(edge_i), ha(edge_i));
+    const Vec3 qa = pa + s * u, qb = pb + t * w;
+    m.normal = n;
+    m.count = 1;
+    m.points[0].position = 0.5 * (qa + qb);
+    m.points[0].separation = (qb - qa).dot(n);
+    m.points[0].id = (1u << 31) | (static_cast<std::uint32_t>(edge_i * 3 + edge_j) << 8) | signs;
+    if (m.points[0].separation >= margin) m.count = 0;
+    return m;
+  }
+
+  std::array<ManifoldPoint, kMaxClipped> clipped{};
+  int n = 0;
+  if (best_b > best_a + kFaceTolerance) {
+    // Reference face on B; its normal points from B to A, the manifold normal is its opposite.
+    const double sign = db(axis_b) > 0.0 ? -1.0 : 1.0;
+    const Vec3 n_ref = sign * b.R.col(axis_b);
+    const std::uint32_t ref_face = static_cast<std::uint32_t>(2 * axis_b + (sign > 0.0 ? 1 : 0));
+    n = clip_faces(Box{b, cb}, axis_b, n_ref, Box{a, ca}, margin, (1u << 15) | (ref_face << 12),
+                   clipped);
+    m.normal = -n_ref;
+  } else {
+    const double sign = da(axis_a) > 0.0 ? 1.0 : -1.0;
+    const Vec3 n_ref = sign * a.R.col(axis_a);
+    const std::uint32_t ref_face = static_cast<std::uint32_t>(2 * axis_a + (sign > 0.0 ? 1 : 0));
+    n = clip_faces(Box{a, ca}, axis_a, n_ref, Box{b, cb}, margin, ref_face << 12, clipped);
+    m.normal = n_ref;
+  }
+  m.count = reduce_to_four(clipped, n, m.normal, m.points);
+  return m;
+}
+
+}  // namespace tumble

@@ -1,0 +1,468 @@
+#include "contact_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "floor_contact.hpp"
+
+namespace tumble {
+namespace {
+
+using PointMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxContactPoints, kMaxContactPoints>;
+using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxContactPoints, 1>;
+
+/// Velocities of a body during the solve (I⁻¹ fixed at the start of the step).
+struct SolverBody {
+  Vec3 v = Vec3::Zero();   // m/s
+  Vec3 w = Vec3::Zero();   // rad/s
+  Vec3 vp = Vec3::Zero();  // split-impulse pseudo velocity, m/s
+  Vec3 wp = Vec3::Zero();  // rad/s
+  Mat3 inv_inertia = Mat3::Zero();
+  double inv_mass = 0.0;
+};
+
+/// Two unit tangents completing n to a right-handed basis, chosen the same way every step so
+/// accumulated friction impulses stay meaningful for warm starting.
+void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  const Vec3 ref = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  t1 = n.cross(ref).normalized();
+  t2 = n.cross(t1);
+}
+
+// Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
+// dynamic simulation of non-penetrating rigid bodies", §4, with equality targets): every
+// active point leaves with v⁺ₙ = target and a non-negative impulse; a point that would pull
+// is dropped, a passive one that would approach is added. K is singular for four coplanar
+// points (a face has three normal degrees of freedom), so each solve uses the pseudo-inverse;
+// rigid-body targets are then consistent and a flat landing stays flat.
+PointVector solve_active_set(const PointMatrix& K, const PointVector& vn, const PointVector& target) {
+  const int n = static_cast<int>(vn.size());
+  std::array<bool, kMaxContactPoints> active{};
+  for (int i = 0; i < n; ++i) active[i] = vn(i) < target(i);
+  PointVector impulse = PointVector::Zero(n);
+  for (int iter = 0; iter < 4 * kMaxContactPoints; ++iter) {
+    std::array<int, kMaxContactPoints> act{};
+    int m = 0;
+    for (int i = 0; i < n; ++i)
+      if (active[i]) act[m++] = i;
+    impulse.setZero();
+    if (m > 0) {
+      PointMatrix Ka(m, m);
+      PointVector rhs(m);
+      for (int r = 0; r < m; ++r) {
+        rhs(r) = target(act[r]) - vn(act[r]);
+        for (int s = 0; s < m; ++s) Ka(r, s) = K(act[r], act[s]);
+      }
+      Eigen::SelfAdjointEigenSolver<PointMatrix> eig(Ka);
+      const PointVector lambda = eig.eigenvalues();
+      const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
+      PointVector y = eig.eigenvectors().transpose() * rhs;
+      for (int r = 0; r < m; ++r) y(r) = std::abs(lambda(r)) > cutoff ? y(r) / lambda(r) : 0.0;
+      const PointVector ja = eig.eigenvectors() * y;
+      for (int r = 0; r < m; ++r) impulse(act[r]) = ja(r);
+    }
+    int worst = -1;
+    double worst_value = -1e-14;
+    for (int i = 0; i < n; ++i)
+      if (active[i] && impulse(i) < worst_value) worst = i, worst_value = impulse(i);
+    if (worst >= 0) {
+      active[worst] = false;
+      continue;
+    }
+    const PointVector after = vn.head(n) + K * impulse;
+    worst_value = -1e-12;
+    for (int i = 0; i < n; ++i)
+      if (!active[i] && after(i) - target(i) < worst_value)
+        worst = i, worst_value = after(i) - target(i);
+    if (worst < 0) break;
+    active[worst] = true;
+  }
+  return impulse;
+}
+
+class Solver {
+ public:
+  Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids,
+         std::vector<std::int32_t>& index)
+      : bodies_(bodies), ids_(ids), index_(index) {
+    index_.assign(bodies.size(), -1);
+    sb_.resize(ids.size());
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+      const Body& b = bodies[ids[k]];
+      index_[ids[k]] = static_cast<std::int32_t>(k);
+      sb_[k].inv_mass = b.c.inv_mass;
+      sb_[k].inv_inertia = inverse_inertia_world(b.s, b.c);
+      sb_[k].v = b.s.P * b.c.inv_mass;
+      sb_[k].w = sb_[k].inv_inertia * b.s.L;
+    }
+  }
+
+  SolverBody* body(std::uint32_t id) { return id == kStaticBody ? nullptr : &sb_[index_[id]]; }
+
+  static Vec3 point_velocity(const SolverBody* s, const Vec3& r) {
+    return s ? Vec3(s->v + s->w.cross(r)) : Vec3::Zero();
+  }
+  static Vec3 pseudo_velocity(const SolverBody* s, const Vec3& r) {
+    return s ? Vec3(s->vp + s->wp.cross(r)) : Vec3::Zero();
+  }
+  /// Impulse j (N·s) on b at rb, −j on a at ra.
+  static void apply(SolverBody* a, SolverBody* b, const Vec3& ra, const Vec3& rb, const Vec3& j) {
+    if (a) a->v -= a->inv_mass * j, a->w -= a->inv_inertia * ra.cross(j);
+    if (b) b->v += b->inv_mass * j, b->w += b->inv_inertia * rb.cross(j);
+  }
+  static void apply_pseudo(SolverBody* a, SolverBody* b, const Vec3& ra, const Vec3& rb,
+                           const Vec3& j) {
+    if (a) a->vp -= a->inv_mass * j, a->wp -= a->inv_inertia * ra.cross(j);
+    if (b) b->vp += b->inv_mass * j, b->wp += b->inv_inertia * rb.cross(j);
+  }
+  /// n·K n for unit impulses along d at ra and rb (the inverse effective mass, 1/kg).
+  static double inverse_mass(const SolverBody* a, const SolverBody* b, const Vec3& ra,
+                             const Vec3& rb, const Vec3& d) {
+    double k = 0.0;
+    if (a) k += a->inv_mass + d.dot((a->inv_inertia * ra.cross(d)).cross(ra));
+    if (b) k += b->inv_mass + d.dot((b->inv_inertia * rb.cross(d)).cross(rb));
+    return k;
+  }
+
+  void prepare(Contact& c, std::size_t n) {
+    SolverBody* a = body(c.a);
+    SolverBody* b = body(c.b);
+    Vec3 t[2];
+    tangents(c.normal, t[0], t[1]);
+    for (int i = 0; i < c.count; ++i) {
+      ContactPoint& p = c.points[i];
+      p.ra = c.a == kStaticBody ? p.position : Vec3(p.position - bodies_[c.a].s.x);
+      p.rb = p.position - bodies_[c.b].s.x;
+      p.normal_mass = 1.0 / inverse_mass(a, b, p.ra, p.rb, c.normal);
+      for (int k = 0; k < 2; ++k) p.tangent_mass[k] = 1.0 / inverse_mass(a, b, p.ra, p.rb, t[k]);
+      p.pseudo_impulse = 0.0;
+    }
+    if (block_.size() <= n) block_.resize(n + 1);
+    block_[n] = pseudo_inverse(normal_matrix_of(c, a, b));
+  }
+
+  static PointMatrix pseudo_inverse(const PointMatrix& K) {
+    Eigen::SelfAdjointEigenSolver<PointMatrix> eig(K);
+    const PointVector lambda = eig.eigenvalues();
+    const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
+    PointVector inv(K.rows());
+    for (int r = 0; r < K.rows(); ++r)
+      inv(r) = std::abs(lambda(r)) > cutoff ? 1.0 / lambda(r) : 0.0;
+    return eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+  }
+
+  int impact(Contact& c, const Vec3& gravity, double dt);
+  void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt);
+  /// K_ij = n·(change of the relative normal velocity at point i per unit impulse at j), 1/kg;
+  /// a or b null: that body is held fixed.
+  PointMatrix normal_matrix_of(const Contact& c, const SolverBody* a, const SolverBody* b) const;
+  void warm_start(Contact& c);
+  void solve_velocity(Contact& c, std::size_t n, double dt);
+  void solve_position(Contact& c, const SolverSettings& s, double dt);
+  void finish(double dt);
+  /// Normal velocity a point must reach: a speculative point may close its gap within the
+  /// step, a touching one may not approach (its penetration is the split impulse's job).
+  static double target_of(const ContactPoint& p, double dt) {
+    return p.separation > 0.0 ? -p.separation / dt : 0.0;
+  }
+
+ private:
+  std::span<Body> bodies_;
+  std::span<const std::uint32_t> ids_;
+  std::vector<std::int32_t>& index_;
+  std::vector<SolverBody> sb_;
+  std::vector<PointMatrix> block_;  // pseudo-inverse of each contact's normal matrix K
+};
+
+// The collision pass of Guendelman, Bridson & Fedkiw 2003 (§5), with each contact's impact
+// solved exactly rather than iterated: the points of one contact that touch within the step
+// and approach faster than the restitution threshold get simultaneous normal impulses that
+// leave every active point with v⁺ₙ = −e v⁻ₙ (an active-set solve as in Baraff 1989, §4, with
+// the pseudo-inverse for a rank-deficient face patch). With e = 1 the kinetic energy change
+// Σ jᵢ (v⁻ᵢ + v⁺ᵢ)/2 is zero and the pair's momentum changes by ±Σ jᵢ n: both are conserved to
+// round-off, as for an isolated impact with the floor. Frictionless: friction acts in the
+// contact pass that follows.
+int Solver::impact(Contact& c, const Vec3& gravity, double dt) {
+  SolverBody* a = body(c.a);
+  SolverBody* b = body(c.b);
+  const double rest = rest_speed(c.restitution, gravity, dt);
+  const double threshold = std::max(rest, 2.0 * gravity.norm() * dt);
+  std::array<int, kMaxContactPoints> idx{};
+  PointVector vn(kMaxContactPoints), target(kMaxContactPoints);
+  int n = 0;
+  bool fast = false;
+  for (int i = 0; i < c.count; ++i) {
+    const ContactPoint& p = c.points[i];
+    const double v = (point_velocity(b, p.rb) - point_velocity(a, p.ra)).dot(c.normal);
+    if (p.separation + std::min(v, 0.0) * dt > 0.0) continue;  // does not touch this step
+    fast = fast || v < -threshold;
+    const double e = (c.restitution * -v < rest) ? 0.0 : c.restitution;
+    idx[n] = i;
+    vn(n) = v;
+    target(n) = v < 0.0 ? -e * v : 0.0;
+    ++n;
+  }
+  if (!fast) return 0;
+  Contact sub = c;  // the touching points only
+  sub.count = n;
+  for (int i = 0; i < n; ++i) sub.points[i] = c.points[idx[i]];
+  const PointMatrix K = normal_matrix_of(sub, a, b);
+  const PointVector impulse = solve_active_set(K, vn.head(n), target.head(n));
+  for (int i = 0; i < n; ++i) {
+    if (impulse(i) <= 0.0) continue;
+    const ContactPoint& p = c.points[idx[i]];
+    apply(a, b, p.ra, p.rb, impulse(i) * c.normal);
+  }
+  return 1;
+}
+
+void Solver::warm_start(Contact& c) {
+  SolverBody* a = body(c.a);
+  SolverBody* b = body(c.b);
+  Vec3 t[2];
+  tangents(c.normal, t[0], t[1]);
+  for (int i = 0; i < c.count; ++i) {
+    const ContactPoint& p = c.points[i];
+    const Vec3 j = p.normal_impulse * c.normal + p.tangent_impulse[0] * t[0] +
+                   p.tangent_impulse[1] * t[1];
+    if (!j.isZero()) apply(a, b, p.ra, p.rb, j);
+  }
+}
+
+// Sequential impulses (Catto, "Iterative dynamics with temporal coherence", GDC 2005, and
+// "Fast and simple physics using sequential impulses", GDC 2006): each point in turn gets the
+// impulse that fixes its own relative velocity, the accumulated total is clamped (normal
+// ≥ 0, friction inside the disc of radius μ λₙ) rather than each increment, and the totals
+// start from the previous step's (warm starting), so a stack's static impulses carry over and
+// only their change has to converge. Speculative points (Catto GDC 2013; Box2D, Jolt) may
+// approach by their gap within the step but no more, so a falling body stops at the surface
+// instead of penetrating first.
+void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
+  SolverBody* a = body(c.a);
+  SolverBody* b = body(c.b);
+  Vec3 t[2];
+  tangents(c.normal, t[0], t[1]);
+  for (int i = 0; i < c.count; ++i) {
+    ContactPoint& p = c.points[i];
+    const Vec3 dv = point_velocity(b, p.rb) - point_velocity(a, p.ra);
+    const double limit = c.friction * p.normal_impulse;
+    const double old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
+    double n0 = old0 - p.tangent_mass[0] * dv.dot(t[0]);
+    double n1 = old1 - p.tangent_mass[1] * dv.dot(t[1]);
+    const double len = std::hypot(n0, n1);
+    if (len > limit) {
+      const double scale = len > 0.0 ? limit / len : 0.0;
+      n0 *= scale;
+      n1 *= scale;
+    }
+    p.tangent_impulse = {n0, n1};
+    apply(a, b, p.ra, p.rb, (n0 - old0) * t[0] + (n1 - old1) * t[1]);
+  }
+  // Block solve of the contact's normal impulses: all points at once through the
+  // pseudo-inverse of K (Box2D's two-point block solver, generalised with the pseudo-inverse
+  // for a face patch, whose four coplanar points have only three independent normal modes).
+  // Point-by-point Gauss–Seidel leaves such a patch rocking; the block step removes it. When
+  // the block answer would pull at a point, the points fall back to one clamped sweep.
+  const int n = c.count;
+  PointVector rhs(n), lambda(n);
+  for (int i = 0; i < n; ++i) {
+    const ContactPoint& p = c.points[i];
+    const double vn = (point_velocity(b, p.rb) - point_velocity(a, p.ra)).dot(c.normal);
+    rhs(i) = target_of(p, dt) - vn;
+    lambda(i) = p.normal_impulse;
+  }
+  const PointVector next = lambda + block_[index] * rhs;
+  if ((next.array() >= 0.0).all()) {
+    for (int i = 0; i < n; ++i) {
+      ContactPoint& p = c.points[i];
+      const double delta = next(i) - p.normal_impulse;
+      p.normal_impulse = next(i);
+      if (delta != 0.0) apply(a, b, p.ra, p.rb, delta * c.normal);
+    }
+    return;
+  }
+  for (int i = 0; i < n; ++i) {
+    ContactPoint& p = c.points[i];
+    const double vn = (point_velocity(b, p.rb) - point_velocity(a, p.ra)).dot(c.normal);
+    const double target = target_of(p, dt);
+    const double next_i = std::max(0.0, p.normal_impulse - p.normal_mass * (vn - target));
+    const double delta = next_i - p.normal_impulse;
+    p.normal_impulse = next_i;
+    if (delta != 0.0) apply(a, b, p.ra, p.rb, delta * c.normal);
+  }
+}
+
+// Shock propagation (Guendelman, Bridson & Fedkiw 2003, §7): after the iterations, one sweep
+// over the contacts from the ground up in which the lower body of each contact counts as
+// immovable, so the upper one alone takes whatever approach the unconverged iterations left.
+// A stack then cannot sink however tall it is, even on the first step before warm starting
+// has built its impulses, and a heavy body on a light one cannot crush it. The sweep only
+// pushes (never pulls) and only where a contact still approaches, so an impact already
+// resolved exactly, or a scene without gravity (no "up"), is untouched.
+void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt) {
+  const double g = gravity.norm();
+  if (g == 0.0) return;
+  const Vec3 up = -gravity / g;
+  auto height = [&](std::uint32_t id) {
+    return id == kStaticBody ? -INFINITY : up.dot(bodies_[id].s.x);
+  };
+  std::vector<std::pair<double, std::uint32_t>> order;
+  order.reserve(contacts.size());
+  for (std::size_t i = 0; i < contacts.size(); ++i)
+    order.emplace_back(std::min(height(contacts[i].a), height(contacts[i].b)),
+                       static_cast<std::uint32_t>(i));
+  std::sort(order.begin(), order.end());
+  for (const auto& [h, i] : order) {
+    Contact& c = contacts[i];
+    const bool a_lower = height(c.a) <= height(c.b);
+    SolverBody* a = a_lower ? nullptr : body(c.a);
+    SolverBody* b = a_lower ? body(c.b) : nullptr;
+    const int n = c.count;
+    PointVector vn(n), target(n);
+    bool approaching = false;
+    for (int k = 0; k < n; ++k) {
+      const ContactPoint& p = c.points[k];
+      vn(k) = (point_velocity(body(c.b), p.rb) - point_velocity(body(c.a), p.ra)).dot(c.normal);
+      target(k) = target_of(p, dt);
+      approaching = approaching || vn(k) < target(k) - 1e-9;
+    }
+    if (!approaching) continue;
+    const PointVector impulse = solve_active_set(normal_matrix_of(c, a, b), vn, target);
+    for (int k = 0; k < n; ++k)
+      if (impulse(k) > 0.0) apply(a, b, c.points[k].ra, c.points[k].rb, impulse(k) * c.normal);
+  }
+}
+
+PointMatrix Solver::normal_matrix_of(const Contact& c, const SolverBody* a,
+                                     const SolverBody* b) const {
+  PointMatrix K(c.count, c.count);
+  for (int i = 0; i < c.count; ++i) {
+    const ContactPoint& pi = c.points[i];
+    for (int j = 0; j < c.count; ++j) {
+      const ContactPoint& pj = c.points[j];
+      double k = 0.0;
+      if (a) k += a->inv_mass + c.normal.dot((a->inv_inertia * pj.ra.cross(c.normal)).cross(pi.ra));
+      if (b) k += b->inv_mass + c.normal.dot((b->inv_inertia * pj.rb.cross(c.normal)).cross(pi.rb));
+      K(i, j) = k;
+    }
+  }
+  return K;
+}
+
+// Split impulse (Catto, GDC 2006 notes; Bullet's splitImpulse): penetration beyond the slop is
+// removed by pseudo velocities that move the positions but never enter the momenta, so the
+// correction adds no energy (Baumgarte's bias would make stacks bounce).
+void Solver::solve_position(Contact& c, const SolverSettings& s, double dt) {
+  SolverBody* a = body(c.a);
+  SolverBody* b = body(c.b);
+  for (int i = 0; i < c.count; ++i) {
+    ContactPoint& p = c.points[i];
+    const double depth = -p.separation - s.slop;
+    if (depth <= 0.0 && p.pseudo_impulse == 0.0) continue;
+    const double target = s.position_gain * std::max(depth, 0.0) / dt;
+    const double vn = (pseudo_velocity(b, p.rb) - pseudo_velocity(a, p.ra)).dot(c.normal);
+    const double next = std::max(0.0, p.pseudo_impulse + p.normal_mass * (target - vn));
+    const double delta = next - p.pseudo_impulse;
+    p.pseudo_impulse = next;
+    if (delta != 0.0) apply_pseudo(a, b, p.ra, p.rb, delta * c.normal);
+  }
+}
+
+void Solver::finish(double dt) {
+  for (std::size_t k = 0; k < ids_.size(); ++k) {
+    Body& body = bodies_[ids_[k]];
+    const SolverBody& s = sb_[k];
+    body.s.P = body.c.mass * s.v;
+    body.s.L = body.s.R * body.c.inertia.cwiseProduct(body.s.R.transpose() * s.w);
+    body.s.x += dt * (s.v + s.vp);
+    const Vec3 turn = dt * (s.w + s.wp);
+    if (!turn.isZero()) body.s.R = rotation_from_vector(turn) * body.s.R;
+  }
+}
+
+}  // namespace
+
+int floor_contact(const BodyState& s, const BodyConstants& c, std::uint32_t body,
+                  double floor_y, double margin, Contact& out) {
+  out.a = kStaticBody;
+  out.b = body;
+  out.normal = Vec3::UnitY();
+  out.friction = c.friction;
+  out.restitution = c.restitution;
+  out.count = 0;
+  if (lowest_vertex_y(s, c) - floor_y >= margin) return 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 p = world_vertex(s, c, i);
+    const double gap = p.y() - floor_y;
+    if (gap >= margin) continue;
+    ContactPoint& cp = out.points[out.count++];
+    cp = ContactPoint{};
+    cp.position = p;
+    cp.separation = gap;
+    cp.id = static_cast<std::uint32_t>(i);
+  }
+  return out.count;
+}
+
+// Points are matched by feature id; a point whose features changed (a vertex that slid past
+// a clipping plane) takes the impulse of the nearest unmatched old point within
+// kWarmStartDistance, as Bullet's persistent manifold does by position alone.
+void warm_start_from(Contact& contact, const Contact& previous) {
+  constexpr double kWarmStartDistance = 0.01;  // m
+  std::array<bool, kMaxContactPoints> used{};
+  std::array<bool, kMaxContactPoints> done{};
+  for (int i = 0; i < contact.count; ++i) {
+    ContactPoint& p = contact.points[i];
+    for (int k = 0; k < previous.count; ++k) {
+      if (used[k] || previous.points[k].id != p.id) continue;
+      p.normal_impulse = previous.points[k].normal_impulse;
+      p.tangent_impulse = previous.points[k].tangent_impulse;
+      used[k] = done[i] = true;
+      break;
+    }
+  }
+  for (int i = 0; i < contact.count; ++i) {
+    if (done[i]) continue;
+    ContactPoint& p = contact.points[i];
+    int best = -1;
+    double best_d2 = kWarmStartDistance * kWarmStartDistance;
+    for (int k = 0; k < previous.count; ++k) {
+      const double d2 = (previous.points[k].position - p.position).squaredNorm();
+      if (!used[k] && d2 < best_d2) best = k, best_d2 = d2;
+    }
+    if (best < 0) continue;
+    p.normal_impulse = previous.points[best].normal_impulse;
+    p.tangent_impulse = previous.points[best].tangent_impulse;
+    used[best] = true;
+  }
+}
+
+// One step of the bodies in contact, in the order of Guendelman, Bridson & Fedkiw 2003:
+// gravity, the collision pass (impacts with restitution), the contact pass (sequential
+// impulses, e = 0), then positions with the corrected velocities — semi-implicit Euler, with
+// the split-impulse pseudo velocities added to the positions only.
+int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
+                   std::span<Contact> contacts, const Vec3& gravity, double dt,
+                   const SolverSettings& settings, std::vector<std::int32_t>& index) {
+  Solver solver(bodies, solver_bodies, index);
+  for (std::uint32_t id : solver_bodies) {
+    SolverBody* s = solver.body(id);
+    s->v += dt * gravity;
+  }
+  for (std::size_t i = 0; i < contacts.size(); ++i) solver.prepare(contacts[i], i);
+  int impacts = 0;
+  for (Contact& c : contacts) impacts += solver.impact(c, gravity, dt);
+  for (Contact& c : contacts) solver.warm_start(c);
+  for (int it = 0; it < settings.velocity_iterations; ++it)
+    for (std::size_t i = 0; i < contacts.size(); ++i) solver.solve_velocity(contacts[i], i, dt);
+  if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt);
+  for (int it = 0; it < settings.position_iterations; ++it)
+    for (Contact& c : contacts) solver.solve_position(c, settings, dt);
+  solver.finish(dt);
+  return impacts;
+}
+
+}  // namespace tumble

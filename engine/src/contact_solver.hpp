@@ -1,0 +1,75 @@
+#pragma once
+/// Contacts between bodies (and between those bodies and the floor) and the solver that steps
+/// the bodies touching each other: exact impact impulses, then sequential impulses with warm
+/// starting and Coulomb friction, then split-impulse position correction.
+/// Pure functions over the caller's buffers; thread-safe.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "tumble/body.hpp"
+
+namespace tumble {
+
+/// Stands for the floor (a static body) in Contact::a.
+inline constexpr std::uint32_t kStaticBody = 0xFFFFFFFFu;
+/// Most points of one contact: 4 for box–box, up to 8 box vertices on the floor.
+inline constexpr int kMaxContactPoints = 8;
+
+/// One point of a contact, with the impulses it accumulated (kept for warm starting).
+struct ContactPoint {
+  Vec3 position = Vec3::Zero();  ///< World, m.
+  double separation = 0.0;       ///< Gap along the normal at the start of the step, m.
+  std::uint32_t id = 0;          ///< Feature id (persistent between steps).
+  double normal_impulse = 0.0;   ///< Accumulated normal impulse, N·s (≥ 0).
+  std::array<double, 2> tangent_impulse{};  ///< Accumulated friction impulse, N·s.
+  // Per-step solver data.
+  Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  ///< Offsets from the centres of mass, m.
+  double normal_mass = 0.0;                   ///< 1 / (n·K n), kg.
+  std::array<double, 2> tangent_mass{};       ///< 1 / (t·K t), kg.
+  double pseudo_impulse = 0.0;                ///< Split-impulse position correction, N·s.
+};
+
+/// The contact of body a (or the floor, a = kStaticBody) with body b: normal from a to b.
+struct Contact {
+  std::uint32_t a = kStaticBody;  ///< Body index, or kStaticBody for the floor.
+  std::uint32_t b = 0;            ///< Body index.
+  Vec3 normal = Vec3::UnitY();    ///< Unit, world, from a to b.
+  double friction = 0.0;          ///< Coulomb μ of the pair.
+  double restitution = 0.0;       ///< e of the pair (applied to impacts only).
+  int count = 0;                  ///< Points in use.
+  std::array<ContactPoint, kMaxContactPoints> points{};
+};
+
+/// Tuning of the contact solver.
+struct SolverSettings {
+  int velocity_iterations = 12;     ///< Sequential-impulse sweeps.
+  int position_iterations = 4;      ///< Split-impulse sweeps.
+  double slop = 2e-4;               ///< Penetration left alone, m.
+  double position_gain = 0.4;       ///< Fraction of the penetration beyond slop removed per step.
+  bool shock_propagation = true;    ///< Final ground-up sweep with lower bodies held fixed.
+};
+
+/// Speculative distance: points closer than this (plus the distance the bodies can close in
+/// a step) are kept as contacts, m.
+inline constexpr double kSpeculativeDistance = 0.02;
+
+/// The floor contact of a body: every vertex closer to the plane y = floor_y than `margin`
+/// (m), normal +y. Returns the number of points.
+int floor_contact(const BodyState& s, const BodyConstants& c, std::uint32_t body,
+                  double floor_y, double margin, Contact& out);
+
+/// Copies the accumulated impulses of points with the same feature id from `previous`.
+void warm_start_from(Contact& contact, const Contact& previous);
+
+/// Steps `bodies[solver_bodies]` by dt under gravity with the contacts: impacts (relative
+/// normal speed above the restitution threshold) get an exact simultaneous impulse per contact
+/// with restitution e; then sequential impulses with warm starting and friction keep resting
+/// contacts from approaching; positions follow by semi-implicit Euler with a split-impulse
+/// correction of deep penetration. `index` is scratch. Returns the number of impacts.
+int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
+                   std::span<Contact> contacts, const Vec3& gravity, double dt,
+                   const SolverSettings& settings, std::vector<std::int32_t>& index);
+
+}  // namespace tumble
