@@ -107,15 +107,28 @@ struct JacobiAgm {
 Mat3 momentum_frame(const Vec3& m) {
   const double rho2 = m[0] * m[0] + m[1] * m[1];
   const double rho = std::sqrt(rho2);
-  const double norm = std::sqrt(rho2 + m[2] * m[2]);
+  const double inv_rho = 1.0 / rho, inv_norm = 1.0 / std::sqrt(rho2 + m[2] * m[2]);
+  const double z = m[2] * inv_norm * inv_rho;
   Mat3 p;
-  p.row(0) << m[1] / rho, -m[0] / rho, 0.0;
-  p.row(1) << m[0] * m[2] / (norm * rho), m[1] * m[2] / (norm * rho), -rho / norm;
-  p.row(2) = m / norm;
+  p.row(0) << m[1] * inv_rho, -m[0] * inv_rho, 0.0;
+  p.row(1) << m[0] * z, m[1] * z, -rho * inv_norm;
+  p.row(2) = m * inv_norm;
   return p;
 }
 
 Mat3 rotation_about_z(double angle) { return axis_rotation(2, angle); }
+
+// Body axes ordered by increasing moment; ties keep the axis order (an insertion sort, stable
+// like std::sort on three elements, without its call overhead).
+std::array<int, 3> axes_by_moment(const Vec3& inertia) {
+  std::array<int, 3> a{0, 1, 2};
+  if (inertia[a[1]] < inertia[a[0]]) std::swap(a[0], a[1]);
+  if (inertia[a[2]] < inertia[a[1]]) {
+    std::swap(a[1], a[2]);
+    if (inertia[a[1]] < inertia[a[0]]) std::swap(a[0], a[1]);
+  }
+  return a;
+}
 
 // The general (three distinct moments) exact flow: elliptic_flow and general_flow.
 //
@@ -155,7 +168,8 @@ struct Jacobi {
 // Σ (−e)ʲ/(2j + 1) to e⁵ is exact to round-off (its first omitted term is below e⁶/13).
 double carlson_rc1(double e) {
   if (std::abs(e) < 1e-3) {
-    return 1.0 + e * (-1.0 / 3.0 + e * (1.0 / 5.0 + e * (-1.0 / 7.0 + e * (1.0 / 9.0 - e / 11.0))));
+    constexpr double c3 = 1.0 / 3.0, c5 = 1.0 / 5.0, c7 = 1.0 / 7.0, c9 = 1.0 / 9.0, c11 = 1.0 / 11.0;
+    return 1.0 + e * (-c3 + e * (c5 + e * (-c7 + e * (c9 - e * c11))));
   }
   if (e > 0.0) {
     const double r = std::sqrt(e);
@@ -175,11 +189,11 @@ double carlson_rc1(double e) {
 // arguments from 0 to 100.
 double carlson_rj(double x, double y, double z, double p) {
   constexpr double kSpreadForSeries = 1.7e-3;  // (2⁻⁵³ / 4)^(1/6)
-  const double a0 = (x + y + z + 2.0 * p) / 5.0;
+  const double a0 = 0.2 * (x + y + z + 2.0 * p);
   const double delta = (p - x) * (p - y) * (p - z);
   const double spread =
-      std::max({std::abs(a0 - x), std::abs(a0 - y), std::abs(a0 - z), std::abs(a0 - p)}) /
-      kSpreadForSeries;
+      std::max({std::abs(a0 - x), std::abs(a0 - y), std::abs(a0 - z), std::abs(a0 - p)}) *
+      (1.0 / kSpreadForSeries);
   double a = a0, scale = 1.0, sum = 0.0;  // scale = 4⁻ᵐ
   double xm = x, ym = y, zm = z, pm = p;
   for (int m = 0; m < 40 && scale * spread >= a; ++m) {
@@ -202,8 +216,9 @@ double carlson_rj(double x, double y, double z, double p) {
   const double E3 = xyz + 2.0 * E2 * P + 4.0 * P2 * P;
   const double E4 = (2.0 * xyz + E2 * P + 3.0 * P2 * P) * P;
   const double E5 = xyz * P2;
-  const double series = 1.0 - 3.0 * E2 / 14.0 + E3 / 6.0 + 9.0 * E2 * E2 / 88.0 - 3.0 * E4 / 22.0 -
-                        9.0 * E2 * E3 / 52.0 + 3.0 * E5 / 26.0;
+  constexpr double c2 = 3.0 / 14.0, c3 = 1.0 / 6.0, c22 = 9.0 / 88.0, c4 = 3.0 / 22.0,
+                   c23 = 9.0 / 52.0, c5 = 3.0 / 26.0;
+  const double series = 1.0 - c2 * E2 + c3 * E3 + c22 * E2 * E2 - c4 * E4 - c23 * E2 * E3 + c5 * E5;
   return scale * series / (a * std::sqrt(a)) + 6.0 * sum;
 }
 
@@ -219,21 +234,21 @@ Jacobi jacobi_near_zero(double u, double k2) {
     u *= 0.5;
     ++doublings;
   }
-  const double u2 = u * u, k4 = k2 * k2;
+  constexpr double f3 = 1.0 / 6.0, f4 = 1.0 / 24.0, f5 = 1.0 / 120.0, f6 = 1.0 / 720.0,
+                   f7 = 1.0 / 5040.0, f8 = 1.0 / 40320.0, f9 = 1.0 / 362880.0;  // 1/j!
+  const double u2 = u * u, k4 = k2 * k2, k6 = k4 * k2;
   Jacobi f;
-  f.sn = u * (1.0 + u2 * (-(1.0 + k2) / 6.0 +
-                          u2 * ((1.0 + 14.0 * k2 + k4) / 120.0 +
-                                u2 * (-(1.0 + 135.0 * k2 + 135.0 * k4 + k4 * k2) / 5040.0 +
-                                      u2 * (1.0 + 1228.0 * k2 + 5478.0 * k4 + 1228.0 * k4 * k2 +
-                                            k4 * k4) / 362880.0))));
-  f.cn = 1.0 + u2 * (-0.5 + u2 * ((1.0 + 4.0 * k2) / 24.0 +
-                                  u2 * (-(1.0 + 44.0 * k2 + 16.0 * k4) / 720.0 +
-                                        u2 * (1.0 + 408.0 * k2 + 912.0 * k4 + 64.0 * k4 * k2) /
-                                            40320.0)));
-  f.dn = 1.0 + u2 * k2 * (-0.5 + u2 * ((4.0 + k2) / 24.0 +
-                                       u2 * (-(16.0 + 44.0 * k2 + k4) / 720.0 +
-                                             u2 * (64.0 + 912.0 * k2 + 408.0 * k4 + k4 * k2) /
-                                                 40320.0)));
+  f.sn = u * (1.0 + u2 * (-(1.0 + k2) * f3 +
+                          u2 * ((1.0 + 14.0 * k2 + k4) * f5 +
+                                u2 * (-(1.0 + 135.0 * k2 + 135.0 * k4 + k6) * f7 +
+                                      u2 * (1.0 + 1228.0 * k2 + 5478.0 * k4 + 1228.0 * k6 +
+                                            k4 * k4) * f9))));
+  f.cn = 1.0 + u2 * (-0.5 + u2 * ((1.0 + 4.0 * k2) * f4 +
+                                  u2 * (-(1.0 + 44.0 * k2 + 16.0 * k4) * f6 +
+                                        u2 * (1.0 + 408.0 * k2 + 912.0 * k4 + 64.0 * k6) * f8)));
+  f.dn = 1.0 + u2 * k2 * (-0.5 + u2 * ((4.0 + k2) * f4 +
+                                       u2 * (-(16.0 + 44.0 * k2 + k4) * f6 +
+                                             u2 * (64.0 + 912.0 * k2 + 408.0 * k4 + k6) * f8)));
   for (int i = 0; i < doublings; ++i) {
     const double s2 = f.sn * f.sn, c2 = f.cn * f.cn, d2 = f.dn * f.dn;
     const double inv = 1.0 / (1.0 - k2 * s2 * s2);
@@ -247,25 +262,26 @@ Jacobi jacobi_near_zero(double u, double k2) {
 // The polhode in canonical axes: amplitudes a_i, rate λ (1/s), k², k'², n, s, and sn, cn, dn
 // of the start phase u0, read off m0 (m1 = a1 cn u0, m2 = s a2 sn u0).
 struct Polhode {
-  double a1, a2, a3, lambda, k2, kc2, n, s;
+  double a1 = 0.0, a2 = 0.0, a3 = 0.0, lambda = 0.0, k2 = 0.0, kc2 = 0.0, n = 0.0, s = 1.0;
   // On the separatrix cn = sech > 0: use the symmetry (m1, m2) → (−m1, −m2) if m1 < 0.
-  double sigma1;
+  double sigma1 = 1.0;
   Jacobi start;
 
-  Polhode(const Vec3& m0, double J1, double J2, double J3, double D1, double D2, double D3)
-      : a1(std::sqrt(J1 * D3 / (J3 - J1))),
-        a2(std::sqrt(J2 * D3 / (J3 - J2))),
-        a3(std::sqrt(J3 * D1 / (J3 - J1))),
-        lambda(std::sqrt((J3 - J2) * D1 / (J1 * J2 * J3))),
-        k2(std::min(1.0, (J2 - J1) * D3 / ((J3 - J2) * D1))),
-        kc2(std::max(0.0, (J3 - J1) * D2 / ((J3 - J2) * D1))),
-        n(-J3 * (J2 - J1) / (J1 * (J3 - J2))),
-        s(J3 > J2 ? 1.0 : -1.0),
-        sigma1(kc2 == 0.0 && m0[0] < 0.0 ? -1.0 : 1.0) {
+  Polhode(const Vec3& m0, double J1, double J2, double J3, double D1, double D2, double D3) {
+    const double r31 = 1.0 / (J3 - J1), r32 = 1.0 / (J3 - J2), r32d1 = r32 / D1;
+    a1 = std::sqrt(J1 * D3 * r31);
+    a2 = std::sqrt(J2 * D3 * r32);
+    a3 = std::sqrt(J3 * D1 * r31);
+    lambda = std::sqrt((J3 - J2) * D1 / (J1 * J2 * J3));
+    k2 = std::min(1.0, (J2 - J1) * D3 * r32d1);
+    kc2 = std::max(0.0, (J3 - J1) * D2 * r32d1);
+    n = -J3 * (J2 - J1) * r32 / J1;
+    s = J3 > J2 ? 1.0 : -1.0;
+    sigma1 = kc2 == 0.0 && m0[0] < 0.0 ? -1.0 : 1.0;
     const double x = sigma1 * m0[0] / a1, y = sigma1 * s * m0[1] / a2;
-    const double h = std::hypot(x, y);
-    start.sn = y / h;
-    start.cn = x / h;
+    const double inv_h = 1.0 / std::sqrt(x * x + y * y);  // 1 up to round-off
+    start.sn = y * inv_h;
+    start.cn = x * inv_h;
     // dn² = cn² + k'² sn² has no cancellation, unlike 1 − k² sn² near u = K, k → 1.
     start.dn = std::sqrt(start.cn * start.cn + kc2 * start.sn * start.sn);
   }
@@ -369,7 +385,8 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   double d_mid = 0.0;
   for (int a : {sorted[0], sorted[2]}) d_mid += mb[a] * mb[a] * (inertia[a] - Ib) / inertia[a];
   // Canonical axes: 3 is the largest moment above the separatrix, the smallest below it.
-  std::array<int, 3> perm = d_mid >= 0.0 ? sorted : std::array<int, 3>{sorted[2], sorted[1], sorted[0]};
+  const std::array<int, 3> perm =
+      d_mid >= 0.0 ? sorted : std::array<int, 3>{sorted[2], sorted[1], sorted[0]};
   const double J1 = inertia[perm[0]], J2 = inertia[perm[1]], J3 = inertia[perm[2]];
   // Steady spin about the middle axis (the unstable equilibrium): a plain rotation.
   if (mb[perm[0]] == 0.0 && mb[perm[2]] == 0.0) {
@@ -381,9 +398,10 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   sgn[1] = odd ? -sgn[2] : sgn[2];
   Vec3 m0(sgn[0] * mb[perm[0]], sgn[1] * mb[perm[1]], sgn[2] * mb[perm[2]]);
 
-  const double D3 = m0[0] * m0[0] * (J3 - J1) / J1 + m0[1] * m0[1] * (J3 - J2) / J2;  // 2E J3 − M²
-  const double D1 = m0[1] * m0[1] * (J2 - J1) / J2 + m0[2] * m0[2] * (J3 - J1) / J3;  // M² − 2E J1
-  const double D2 = m0[0] * m0[0] * (J1 - J2) / J1 + m0[2] * m0[2] * (J3 - J2) / J3;  // M² − 2E J2
+  const double q1 = m0[0] * m0[0] / J1, q2 = m0[1] * m0[1] / J2, q3 = m0[2] * m0[2] / J3;
+  const double D3 = q1 * (J3 - J1) + q2 * (J3 - J2);  // 2E J3 − M²
+  const double D1 = q2 * (J2 - J1) + q3 * (J3 - J1);  // M² − 2E J1
+  const double D2 = q1 * (J1 - J2) + q3 * (J3 - J2);  // M² − 2E J2
 
   Mat3 frame = Mat3::Zero();  // R0 Cᵀ
   for (int i = 0; i < 3; ++i) frame.col(i) = sgn[i] * R.col(perm[i]);
@@ -403,8 +421,7 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
 
 Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
   if (L.squaredNorm() == 0.0 || t == 0.0) return R;
-  std::array<int, 3> sorted{0, 1, 2};
-  std::sort(sorted.begin(), sorted.end(), [&](int a, int b) { return inertia[a] < inertia[b]; });
+  const std::array<int, 3> sorted = axes_by_moment(inertia);
   const double lo = inertia[sorted[0]], mid = inertia[sorted[1]], hi = inertia[sorted[2]];
   const double tol = kEqualMoments * hi;
   if (hi - lo <= tol) {
@@ -428,8 +445,7 @@ Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, doub
 // so second order; each sub-flow is an exact rotation, so |m| and L = R m are conserved to
 // round-off. See kSplittingOrder for the choice of a, b, c.
 Mat3 free_rotation_splitting(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
-  std::array<int, 3> sorted{0, 1, 2};
-  std::sort(sorted.begin(), sorted.end(), [&](int a, int b) { return inertia[a] < inertia[b]; });
+  const std::array<int, 3> sorted = axes_by_moment(inertia);
   // Outer, middle and central flows as indices into the sorted moments (smallest = 0):
   // T_min(h/2) T_mid(h/2) T_max(h) T_mid(h/2) T_min(h/2). The leading error term (and so the
   // energy error) depends on the ordering by orders of magnitude (Fassò, J. Comput. Phys. 189,
