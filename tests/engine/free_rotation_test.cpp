@@ -223,6 +223,62 @@ TEST(FreeRotationExact, GeneralCasesMatchReference) {
   }
 }
 
+// A step (|λt| ≤ 1) takes the addition-theorem path, a longer call the half-period reduction:
+// single calls from 1/240 s to 4 s cross from one to the other for every case, and composed
+// steps of 1/240, 1/30 and 1/15 s over 2 s run the step path only; all against the reference.
+TEST(FreeRotationExact, StepsAndLongCallsMatchReference) {
+  // Reference times: every 1/240 s up to 2 s (index i − 1 for i/240 s), then 3 and 4 s.
+  std::vector<double> times;
+  for (int i = 1; i <= 480; ++i) times.push_back(i / 240.0);
+  times.push_back(3.0);
+  times.push_back(4.0);
+  const std::vector<int> single{1, 4, 12, 24, 48, 84, 120, 168, 216, 288, 384, 480, 481, 482};
+  const double bound = 1e-12;
+  for (const GeneralCase& c : general_cases()) {
+    const auto ref = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                                 Method::kMatrixBulirschStoer);
+    double worst_single = 0.0;
+    for (int i : single) {
+      const double t = times[static_cast<size_t>(i - 1)];
+      const double e = rotation_angle_between(ref[static_cast<size_t>(i - 1)],
+                                               free_rotation_exact(c.inertia, c.R0, c.L, t));
+      worst_single = std::max(worst_single, e);
+      EXPECT_LT(e, bound) << c.name << " t " << t;
+    }
+    double worst_composed = 0.0;
+    for (int stride : {1, 8, 16}) {  // dt = 1/240, 1/30, 1/15 s
+      Mat3 R = c.R0;
+      for (int i = stride; i <= 480; i += stride) {
+        R = free_rotation_exact(c.inertia, R, c.L, stride / 240.0);
+        worst_composed =
+            std::max(worst_composed, rotation_angle_between(ref[static_cast<size_t>(i - 1)], R));
+      }
+    }
+    report(c.name + "_single_calls_to_4s_rad", worst_single);
+    report(c.name + "_composed_steps_2s_rad", worst_composed);
+    EXPECT_LT(worst_composed, bound) << c.name;
+  }
+}
+
+// The flow is a group: a step back undoes a step forward, and two half steps make one step.
+TEST(FreeRotationExact, StepBackAndHalfStepsCompose) {
+  double worst_back = 0.0, worst_halves = 0.0;
+  for (const GeneralCase& c : general_cases()) {
+    for (double t : {1.0 / 240, 1.0 / 30, 0.3}) {
+      const Mat3 forward = free_rotation_exact(c.inertia, c.R0, c.L, t);
+      const Mat3 back = free_rotation_exact(c.inertia, forward, c.L, -t);
+      const Mat3 half = free_rotation_exact(c.inertia, c.R0, c.L, 0.5 * t);
+      const Mat3 halves = free_rotation_exact(c.inertia, half, c.L, 0.5 * t);
+      worst_back = std::max(worst_back, rotation_angle_between(c.R0, back));
+      worst_halves = std::max(worst_halves, rotation_angle_between(forward, halves));
+    }
+  }
+  report("step_back_worst_rad", worst_back);
+  report("two_half_steps_worst_rad", worst_halves);
+  EXPECT_LT(worst_back, 1e-14);
+  EXPECT_LT(worst_halves, 1e-14);
+}
+
 // Exactly on the separatrix (k = 1, the sech/tanh limit): inertia (1, 4, 16) and m = (1, ·, 2)
 // make M² − 2E I_mid vanish in floating point. The motion is unstable there (round-off grows
 // like e^{λt}), so the comparison is over a few seconds only.
