@@ -19,9 +19,16 @@ Broadcaster::Broadcaster(net::io_context& ioc, SimLoop& sim, std::chrono::millis
 
 void Broadcaster::start() {
   net::post(strand_, [this] {
-    next_ = Clock::now() + interval_;
-    do_tick();
+    started_ = true;
+    wake();
   });
+}
+
+void Broadcaster::wake() {
+  if (!started_ || stopped_ || ticking_ || viewers() == 0) return;
+  ticking_ = true;
+  next_ = Clock::now() + interval_;
+  do_tick();
 }
 
 void Broadcaster::stop() {
@@ -36,6 +43,7 @@ bool Broadcaster::join(const std::shared_ptr<WsSession>& session) {
   std::erase_if(sessions_, [](const auto& kv) { return kv.second.expired(); });
   if (sessions_.size() >= max_viewers_) return false;
   sessions_.emplace(session.get(), session);
+  net::post(strand_, [this] { wake(); });  // The timer sleeps while nobody watches.
   return true;
 }
 
@@ -72,15 +80,20 @@ void Broadcaster::do_tick() {
 // Copy the frame once into a shared buffer; lock the weak references outside the mutex's
 // critical work and deliver to each (Beast chat-multi shared_state::send).
 void Broadcaster::on_tick(boost::system::error_code ec) {
-  if (ec || stopped_) return;
+  if (ec || stopped_) {
+    ticking_ = false;
+    return;
+  }
   const Clock::time_point now = Clock::now();
   const auto live = sessions();
-  if (!live.empty()) {
-    const std::shared_ptr<const Snapshot> snap = sim_.latest();
-    auto frame = std::make_shared<const std::string>(
-        encode_frame(*snap, frame_number_++, frame_time(*snap, now)));
-    for (const auto& s : live) s->deliver(frame, snap->scene);
+  if (live.empty()) {  // No viewer: no encoding and no timer until one joins.
+    ticking_ = false;
+    return;
   }
+  const std::shared_ptr<const Snapshot> snap = sim_.latest();
+  auto frame = std::make_shared<const std::string>(
+      encode_frame(*snap, frame_number_++, frame_time(*snap, now)));
+  for (const auto& s : live) s->deliver(frame, snap->scene);
   next_ += interval_;
   while (next_ <= now) next_ += interval_;  // Late by more than a period: skip, don't burst.
   do_tick();

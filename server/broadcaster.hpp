@@ -24,7 +24,8 @@ class Broadcaster {
   Broadcaster(boost::asio::io_context& ioc, SimLoop& sim, std::chrono::milliseconds interval,
               std::size_t max_viewers);
 
-  /// Starts the frame timer (absolute deadlines: start + k · interval).
+  /// Starts the frame timer (absolute deadlines: start + k · interval). It runs only while a
+  /// viewer is connected.
   void start();
   /// Stops the timer; no frame is sent afterwards.
   void stop();
@@ -40,6 +41,7 @@ class Broadcaster {
   std::shared_ptr<const SceneInfo> current_scene() const { return sim_.latest()->scene; }
 
  private:
+  void wake();
   void do_tick();
   void on_tick(boost::system::error_code ec);
   std::vector<std::shared_ptr<WsSession>> sessions();
@@ -51,7 +53,9 @@ class Broadcaster {
   boost::asio::steady_timer timer_;
   Clock::time_point next_{};
   std::uint32_t frame_number_ = 0;
+  bool started_ = false;  // On strand_.
   bool stopped_ = false;  // On strand_.
+  bool ticking_ = false;  // On strand_: a timer wait is pending.
   mutable std::mutex mutex_;
   std::unordered_map<const WsSession*, std::weak_ptr<WsSession>> sessions_;
 };

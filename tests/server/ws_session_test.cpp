@@ -219,6 +219,18 @@ TEST_F(WsSessionTest, StopSendsACloseFrame) {
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 1s);
 }
 
+TEST_F(WsSessionTest, NoViewerNoFrames) {
+  std::uint32_t last = 0;
+  {
+    WsClient c(port_);
+    last = next_frame(c).frame_number;
+  }
+  std::this_thread::sleep_for(300ms);  // 15 frame periods without a viewer.
+  WsClient c(port_);
+  const DecodedFrame f = next_frame(c);
+  EXPECT_LE(f.frame_number, last + 3) << "frames were encoded while nobody watched";
+}
+
 class WsSessionLimited : public WsSessionTest {
   void configure(ServerOptions& o) override { o.max_viewers = 1; }
 };
