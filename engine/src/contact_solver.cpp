@@ -303,6 +303,7 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
 // pushes (never pulls) and only where a contact still approaches, so an impact already
 // resolved exactly, or a scene without gravity (no "up"), is untouched.
 void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt) {
+  constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
   const double g = gravity.norm();
   if (g == 0.0) return;
   const Vec3 up = -gravity / g;
@@ -317,7 +318,11 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   std::sort(order.begin(), order.end());
   for (const auto& [h, i] : order) {
     Contact& c = contacts[i];
-    const bool a_lower = height(c.a) <= height(c.b);
+    // The supporting body is the one the normal points away from; a contact whose normal is
+    // nearly horizontal supports nothing and is left to the iterations.
+    const double lift = c.normal.dot(up);
+    if (std::abs(lift) < kSupportCosine) continue;
+    const bool a_lower = lift > 0.0;
     SolverBody* a = a_lower ? nullptr : body(c.a);
     SolverBody* b = a_lower ? body(c.b) : nullptr;
     const int n = c.count;

@@ -13,6 +13,22 @@ namespace {
 constexpr double kIslandSleepSpeed = 0.05;
 constexpr double kIslandSleepTime = 0.5;
 constexpr int kMaxWakeRounds = 8;
+// A body pair joins the contact solve only when a point of its manifold is closer than this
+// (m) or will close its gap within the step at the current velocities. Pairs that merely pass
+// near each other keep the floor-only path with the scene's exact integrator.
+constexpr double kTouchDistance = 1e-3;
+
+/// True when some point of the manifold touches or will touch within dt.
+bool touches(const BoxManifold& m, const Body& a, const Body& b, double dt) {
+  const Vec3 va = a.s.P * a.c.inv_mass, vb = b.s.P * b.c.inv_mass;
+  const Vec3 wa = angular_velocity(a.s, a.c), wb = angular_velocity(b.s, b.c);
+  for (int i = 0; i < m.count; ++i) {
+    const Vec3& p = m.points[i].position;
+    const double vn = (vb + wb.cross(p - b.s.x) - va - wa.cross(p - a.s.x)).dot(m.normal);
+    if (m.points[i].separation + std::min(vn, 0.0) * dt <= kTouchDistance) return true;
+  }
+  return false;
+}
 
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
   return (static_cast<std::uint64_t>(a) << 32) | b;
@@ -47,7 +63,7 @@ int collide(ContactState& k, std::span<Body> bodies, const WorldDef& w, double d
                                  angular_velocity(a.s, a.c).norm() * a.c.bounding_radius +
                                  angular_velocity(b.s, b.c).norm() * b.c.bounding_radius);
     const BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
-    if (m.count == 0) continue;
+    if (m.count == 0 || !touches(m, a, b, dt)) continue;
     Contact c;
     c.a = p.first;
     c.b = p.second;

@@ -1,0 +1,285 @@
+// Box–box contact: the narrow phase, impacts (momentum and energy), stacks (tower, pyramid,
+// 100:1), dominoes, islands that sleep and wake together, determinism with many contacts.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "box_box.hpp"
+#include "world_fixture.hpp"
+
+namespace tumble {
+namespace {
+
+using testing::world_from_json;
+
+/// Deepest penetration (m, ≥ 0) between any two bodies and between any body and the floor.
+double deepest_penetration(const World& world) {
+  double deepest = 0.0;
+  const auto bodies = world.bodies();
+  const double floor_y = world.settings().floor ? world.settings().floor->height : -INFINITY;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const Body& a = bodies[i];
+    deepest = std::max(deepest, floor_y - (a.s.x.y() - a.s.R.row(1).cwiseAbs().dot(a.c.half_extents)));
+    for (std::size_t j = i + 1; j < bodies.size(); ++j) {
+      const Body& b = bodies[j];
+      if ((a.s.x - b.s.x).norm() > a.c.bounding_radius + b.c.bounding_radius) continue;
+      const BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, 0.0);
+      for (int k = 0; k < m.count; ++k) deepest = std::max(deepest, -m.points[k].separation);
+    }
+  }
+  return deepest;
+}
+
+double largest_displacement(const World& world, const std::vector<Vec3>& start) {
+  double d = 0.0;
+  for (std::size_t i = 0; i < start.size(); ++i)
+    d = std::max(d, (world.bodies()[i].s.x - start[i]).norm());
+  return d;
+}
+
+std::vector<Vec3> positions(const World& world) {
+  std::vector<Vec3> x;
+  for (const Body& b : world.bodies()) x.push_back(b.s.x);
+  return x;
+}
+
+BodyState at(const Vec3& x, const Mat3& R = Mat3::Identity()) {
+  BodyState s;
+  s.x = x;
+  s.R = R;
+  return s;
+}
+
+// ---- narrow phase -------------------------------------------------------------------------
+
+TEST(BoxBox, FaceOnFaceGivesFourPointsAtTheRightDepth) {
+  const BodyConstants c = make_body_constants(BodyDef{}, 0.0, 0.0);
+  const BoxManifold m = collide_boxes(at({0, 0, 0}), c, at({0.2, 0.99, 0.1}), c, 0.0);
+  ASSERT_EQ(m.count, 4);
+  EXPECT_LT((m.normal - Vec3::UnitY()).norm(), 1e-15);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(m.points[i].separation, -0.01, 1e-15);
+    EXPECT_NEAR(m.points[i].position.y(), 0.495, 1e-15);
+    // The overlap of the two faces: x ∈ [−0.3, 0.5], z ∈ [−0.4, 0.5].
+    EXPECT_GE(m.points[i].position.x(), -0.3 - 1e-4);
+    EXPECT_LE(m.points[i].position.z(), 0.5 + 1e-4);
+  }
+}
+
+TEST(BoxBox, SeparatedBeyondMarginGivesNothingWithinMarginGivesSpeculativePoints) {
+  const BodyConstants c = make_body_constants(BodyDef{}, 0.0, 0.0);
+  EXPECT_EQ(collide_boxes(at({0, 0, 0}), c, at({1.05, 0, 0}), c, 0.02).count, 0);
+  const BoxManifold m = collide_boxes(at({0, 0, 0}), c, at({1.01, 0, 0}), c, 0.02);
+  ASSERT_EQ(m.count, 4);
+  EXPECT_NEAR(m.points[0].separation, 0.01, 1e-14);
+  EXPECT_LT((m.normal - Vec3::UnitX()).norm(), 1e-15);
+}
+
+TEST(BoxBox, CrossedEdgesMeetAtOnePoint) {
+  // Two cubes turned 45° about x and about z, stacked so their edges cross at the origin.
+  const BodyConstants c = make_body_constants(BodyDef{}, 0.0, 0.0);
+  const double r = std::sqrt(0.5);
+  const Mat3 Ra = axis_rotation(0, M_PI / 4), Rb = axis_rotation(2, M_PI / 4);
+  const BoxManifold m = collide_boxes(at({0, -r + 0.001, 0}, Ra), c, at({0, r - 0.001, 0}, Rb), c, 0.0);
+  ASSERT_EQ(m.count, 1);
+  EXPECT_NEAR(m.points[0].separation, -0.002, 1e-12);
+  EXPECT_LT(m.points[0].position.norm(), 1e-12);
+  EXPECT_NEAR(std::abs(m.normal.y()), 1.0, 1e-12);
+}
+
+// ---- impacts -------------------------------------------------------------------------------
+
+/// Two cubes (masses m1, m2) on the x axis, the first moving at v toward the second at rest;
+/// no gravity, no floor.
+World head_on(double m1, double m2, double v, double e) {
+  const std::string json = R"({"floor": null, "gravity": [0,0,0], "dt": 0.0166666666666667,
+      "bodies": [{"name": "a", "mass": )" + std::to_string(m1) + R"(, "position": [-1.5, 0, 0],
+                  "velocity": [)" + std::to_string(v) + R"(, 0, 0], "restitution": )" +
+                          std::to_string(e) + R"(},
+                 {"name": "b", "mass": )" + std::to_string(m2) + R"(, "position": [1.5, 0, 0],
+                  "restitution": )" + std::to_string(e) + "}]}";
+  return world_from_json(json);
+}
+
+TEST(Impact, HeadOnElasticConservesMomentumAndEnergyToRoundOff) {
+  for (const double m2 : {1.0, 3.0}) {
+    World world = head_on(1.0, m2, 2.0, 1.0);
+    const Vec3 p0 = world.body(0).s.P + world.body(1).s.P;
+    const double e0 = world.total_energy();
+    for (int i = 0; i < 120; ++i) world.step();
+    ASSERT_GE(world.total_impacts(), 1u);
+    const Vec3 p1 = world.body(0).s.P + world.body(1).s.P;
+    const double energy_error = std::abs(world.total_energy() / e0 - 1.0);
+    const double momentum_error = (p1 - p0).norm() / p0.norm();
+    EXPECT_LE(energy_error, 1e-14) << "m2 = " << m2;
+    EXPECT_LE(momentum_error, 1e-15) << "m2 = " << m2;
+    // 1D elastic collision: v1' = (m1 − m2)/(m1 + m2) v, v2' = 2 m1/(m1 + m2) v.
+    EXPECT_NEAR(world.body(0).s.P.x(), (1.0 - m2) / (1.0 + m2) * 2.0, 1e-13);
+    EXPECT_NEAR(world.body(1).s.P.x() / m2, 2.0 / (1.0 + m2) * 2.0, 1e-13);
+    EXPECT_LT(world.body(0).s.L.norm() + world.body(1).s.L.norm(), 1e-13);  // no spin
+    std::cout << "[ measured ] head-on e = 1, m2/m1 = " << m2 << ": relative energy error "
+              << energy_error << ", relative momentum error " << momentum_error << "\n";
+  }
+}
+
+TEST(Impact, HeadOnInelasticMovesOnTogether) {
+  World world = head_on(1.0, 3.0, 2.0, 0.0);
+  for (int i = 0; i < 120; ++i) world.step();
+  const double v_common = 2.0 / 4.0;  // momentum 2 kg·m/s over 4 kg
+  EXPECT_NEAR(world.body(0).s.P.x(), v_common, 1e-13);
+  EXPECT_NEAR(world.body(1).s.P.x() / 3.0, v_common, 1e-13);
+  EXPECT_NEAR((world.body(0).s.P + world.body(1).s.P).x(), 2.0, 1e-14);
+  // Touching (within the speculative gap), never inside each other.
+  const double gap = world.body(1).s.x.x() - world.body(0).s.x.x() - 1.0;
+  EXPECT_GE(gap, 0.0);
+  EXPECT_LT(gap, 2.0 / 60.0 + 1e-12);
+}
+
+// ---- stacks --------------------------------------------------------------------------------
+
+// The tower of 10 kept awake (a zero impulse every 0.25 s stops it from sleeping) for 60 s of
+// sim time: no body drifts more than 1 mm or ever penetrates more than 1 mm.
+TEST(Stack, TowerOfTenStandsSixtySeconds) {
+  World world(load_scene("tower"));
+  const std::vector<Vec3> start = positions(world);
+  double deepest = 0.0;
+  for (int i = 1; i <= 3600; ++i) {
+    if (i % 15 == 0) world.apply_impulse(0, Vec3::Zero());
+    world.step();
+    deepest = std::max(deepest, deepest_penetration(world));
+  }
+  EXPECT_EQ(world.awake_count(), 10u);
+  const double drift = largest_displacement(world, start);
+  EXPECT_LE(drift, 1e-3);
+  EXPECT_LE(deepest, 1e-3);
+  std::cout << "[ measured ] tower of 10 awake for 60 s: largest drift " << drift
+            << " m, deepest penetration " << deepest << " m\n";
+}
+
+TEST(Stack, TowerSleepsAsOneIslandAndAFallingBoxWakesIt) {
+  Scene scene = load_scene("tower");
+  BodyDef extra;
+  extra.name = "dropped";
+  extra.position = Vec3(0.2, 30.0, 0.0);  // lands after about 2 s
+  scene.bodies.push_back(extra);
+  World world(scene);
+  for (int i = 0; i < 60; ++i) world.step();
+  for (BodyId id = 0; id < 10; ++id) EXPECT_EQ(world.body(id).activity, Activity::asleep);
+  EXPECT_EQ(world.body(10).activity, Activity::awake);
+  const BodyState bottom = world.body(0).s;
+  int woke_at = -1;
+  for (int i = 0; i < 180 && woke_at < 0; ++i) {
+    world.step();
+    if (world.body(0).activity == Activity::awake) woke_at = i;
+  }
+  ASSERT_GE(woke_at, 0) << "the falling box should wake the whole tower through its top box";
+  EXPECT_GT(world.last_step().solver_bodies, 10u);
+  for (int i = 0; i < 600; ++i) world.step();
+  EXPECT_EQ(world.awake_count(), 0u);  // everything asleep again
+  // A 1 kg box landing at 24 m/s shakes the tower but it stays standing.
+  EXPECT_LT((world.body(0).s.x - bottom.x).norm(), 1e-2);
+  for (const Body& b : world.bodies()) EXPECT_GT(b.s.R(1, 1), 0.99);
+  EXPECT_LE(deepest_penetration(world), 1e-3);
+}
+
+TEST(Stack, PyramidOfTwoHundredTenFallsAsleepStanding) {
+  World world(load_scene("pyramid"));
+  ASSERT_EQ(world.bodies().size(), 210u);
+  const std::vector<Vec3> start = positions(world);
+  double asleep_at = -1.0;
+  for (int i = 0; i < 600 && asleep_at < 0.0; ++i) {
+    world.step();
+    if (world.awake_count() == 0) asleep_at = world.time();
+  }
+  ASSERT_GT(asleep_at, 0.0);
+  EXPECT_LE(asleep_at, 3.0);
+  const double drift = largest_displacement(world, start);
+  EXPECT_LE(drift, 0.02);
+  EXPECT_LE(deepest_penetration(world), 1e-3);
+  for (const Body& b : world.bodies()) EXPECT_GT(b.s.R(1, 1), 0.999);  // all upright
+  std::cout << "[ measured ] pyramid (210 boxes) asleep at " << asleep_at
+            << " s, largest displacement " << drift << " m\n";
+}
+
+TEST(Stack, HeavyOnLightHolds) {
+  World world(load_scene("heavy_on_light"));
+  ASSERT_NEAR(world.body(1).c.mass / world.body(0).c.mass, 100.0, 1e-12);
+  const std::vector<Vec3> start = positions(world);
+  double deepest = 0.0;
+  for (int i = 1; i <= 1200; ++i) {
+    if (i % 15 == 0) world.apply_impulse(0, Vec3::Zero());  // keep it awake
+    world.step();
+    deepest = std::max(deepest, deepest_penetration(world));
+  }
+  EXPECT_LE(largest_displacement(world, start), 1e-3);
+  EXPECT_LE(deepest, 1e-3);
+  std::cout << "[ measured ] 100:1 stack awake for 20 s: displacement "
+            << largest_displacement(world, start) << " m, deepest penetration " << deepest
+            << " m\n";
+}
+
+TEST(Dominoes, TheFirstKnocksDownTheRest) {
+  World world(load_scene("dominoes"));
+  for (int i = 0; i < 600; ++i) world.step();
+  for (const Body& b : world.bodies()) EXPECT_LT(b.s.R(1, 1), 0.5) << "a domino still stands";
+  EXPECT_LE(deepest_penetration(world), 5e-3);
+}
+
+// ---- determinism and cost ------------------------------------------------------------------
+
+TEST(Determinism, ManyContactsGiveBitIdenticalStatesAndCopiesContinueIdentically) {
+  Scene scene = load_scene("pile");
+  scene.bodies.resize(300);  // three layers that land on each other
+  auto run = [&scene](int steps) {
+    World world(scene);
+    for (int i = 0; i < steps; ++i) world.step();
+    return world;
+  };
+  World a = run(150);
+  World b = run(150);
+  ASSERT_GT(a.last_step().contacts, 50u);
+  World c = a;  // a copy carries the contact cache and sleep groups
+  for (int i = 0; i < 100; ++i) a.step(), b.step(), c.step();
+  for (std::size_t i = 0; i < a.bodies().size(); ++i) {
+    EXPECT_EQ(std::memcmp(&a.bodies()[i].s, &b.bodies()[i].s, sizeof(BodyState)), 0) << i;
+    EXPECT_EQ(std::memcmp(&a.bodies()[i].s, &c.bodies()[i].s, sizeof(BodyState)), 0) << i;
+  }
+}
+
+TEST(Pile, ThreeHundredBoxesSettleAndSleepWithoutDeepPenetration) {
+  Scene scene = load_scene("pile");
+  scene.bodies.resize(300);
+  World world(scene);
+  double asleep_at = -1.0;
+  for (int i = 0; i < 1800 && asleep_at < 0.0; ++i) {  // 30 s at most
+    world.step();
+    if (world.awake_count() == 0) asleep_at = world.time();
+  }
+  EXPECT_GT(asleep_at, 0.0);
+  EXPECT_EQ(world.frozen_count(), 0u);
+  EXPECT_LE(deepest_penetration(world), 5e-3);
+}
+
+// Bodies that never come near each other run no narrow phase, and each moves bit for bit as
+// it would alone: the floor-only path (exact flight, TOI, resting contact) is untouched.
+TEST(BroadPhase, BodiesThatNeverMeetMoveExactlyAsAlone) {
+  const std::string body_a = R"({"name": "a", "size": [1, 2, 3], "position": [0, 3, 0],
+      "orientation": [0.9, 0.1, 0.3, 0.2], "angular_velocity": [1, 2, 0.5]})";
+  const std::string body_b = R"({"name": "b", "position": [6, 2, 0], "velocity": [0, 1, 0],
+      "angular_velocity": [0, 3, 1]})";
+  const std::string head = R"({"floor": {"restitution": 0.5, "friction": 0.3}, "bodies": [)";
+  World alone = world_from_json(head + body_a + "]}");
+  World both = world_from_json(head + body_a + "," + body_b + "]}");
+  for (int i = 0; i < 600; ++i) {
+    alone.step();
+    both.step();
+    ASSERT_EQ(both.last_step().contacts, 0u);
+    ASSERT_EQ(both.last_step().solver_bodies, 0u);
+  }
+  EXPECT_GT(alone.total_impacts(), 0u);
+  EXPECT_EQ(std::memcmp(&alone.body(0).s, &both.body(0).s, sizeof(BodyState)), 0);
+}
+
+}  // namespace
+}  // namespace tumble
