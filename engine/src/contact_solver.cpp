@@ -252,7 +252,7 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
     const double old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
     double n0 = old0 - p.tangent_mass[0] * dv.dot(t[0]);
     double n1 = old1 - p.tangent_mass[1] * dv.dot(t[1]);
-    const double len = std::hypot(n0, n1);
+    const double len = std::sqrt(n0 * n0 + n1 * n1);
     if (len > limit) {
       const double scale = len > 0.0 ? limit / len : 0.0;
       n0 *= scale;
