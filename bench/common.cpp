@@ -39,8 +39,8 @@ void Progress::note(std::string text) {
 
 void Progress::draw(bool force) {
   const auto now = std::chrono::steady_clock::now();
-  if (!force && now - last_draw_ < std::chrono::milliseconds(100)) return;
-  if (!tty_ && !force) return;
+  // A terminal is redrawn in place up to 10×/s; a log file gets a line every 10 s at most.
+  if (!force && now - last_draw_ < std::chrono::milliseconds(tty_ ? 100 : 10000)) return;
   last_draw_ = now;
   constexpr int kWidth = 30;
   const double f = static_cast<double>(done_) / static_cast<double>(total_);

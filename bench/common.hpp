@@ -22,7 +22,8 @@ struct Options {
   int repeats = 3;     ///< Interleaved repetitions for timings (median taken).
 };
 
-/// A progress bar on stderr: "label [#####.....]  45%  9/20  3.1 s". Redraws at most 10×/s.
+/// A progress bar on stderr: "label [#####.....]  45%  9/20  3.1 s". Redraws at most 10×/s on
+/// a terminal; into a file, one line every 10 s at most.
 class Progress {
  public:
   Progress(std::string label, std::size_t total);

@@ -4,6 +4,8 @@
 ///   tumble-bench work-precision      # one question only; the docs are re-assembled
 #include <boost/program_options.hpp>
 
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <functional>
@@ -35,6 +37,29 @@ std::string machine_description() {
   uname(&u);
   return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " logical cores, " +
          u.sysname + " " + u.release + ", compiler " + __VERSION__;
+}
+
+/// The engine commit measured: $TUMBLE_BENCH_COMMIT if set (a build from an exported tree),
+/// else `git rev-parse --short HEAD` of the source tree, marked "+ local changes" when
+/// engine/ differs from it.
+std::string engine_commit() {
+  if (const char* env = std::getenv("TUMBLE_BENCH_COMMIT")) return env;
+  const std::string src = TUMBLE_BENCH_SOURCE_DIR;
+  auto run = [](const std::string& cmd) {
+    std::string out;
+    if (FILE* p = ::popen(cmd.c_str(), "r")) {
+      char buf[256];
+      while (std::fgets(buf, sizeof buf, p)) out += buf;
+      ::pclose(p);
+    }
+    while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+    return out;
+  };
+  const std::string head = run("git -C '" + src + "' rev-parse --short HEAD 2>/dev/null");
+  if (head.empty()) return "unknown";
+  const std::string dirty =
+      run("git -C '" + src + "' status --porcelain -- engine reference 2>/dev/null");
+  return head + (dirty.empty() ? "" : " + local changes");
 }
 
 std::string today() {
@@ -102,6 +127,7 @@ int main(int argc, char** argv) {
   }
   record_value(o, "machine", machine_description());
   record_value(o, "date", today());
+  record_value(o, "engine_commit", engine_commit());
 
   const double start = wall_seconds();
   const std::vector<std::string> order = {"work-precision", "stability", "throughput", "skip",

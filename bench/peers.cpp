@@ -142,8 +142,15 @@ void run_peers(const Options& o) {
   md << "### `tumble` on every engine\n\n"
      << image_link(o, tplot, "tumble: peers work-precision") << "\n\n"
      << md_table({"engine", "error at dt = 1/30 (rad)", "error at dt = 1/120 (rad)"}, trows)
-     << "\nSame initial state and the same `tumble_reference` solution for every engine. "
-        "CSV: "
+     << "\nSame initial state and the same `tumble_reference` solution for every engine "
+        "(box 1 × 2 × 3 m spun about its middle axis, no gravity, 20 s, dt = 1/15 … "
+     << (o.quick ? "1/120" : "1/3840")
+     << " s). What it shows: the plot draws the geodesic orientation error at 20 s against "
+        "the CPU time of the whole run, one point per dt, one curve per engine (errors of "
+        "exactly 0 are drawn at 1e-17). The peers integrate rotation with first-order "
+        "(Bullet, ODE, MuJoCo Euler) or fourth-order (MuJoCo RK4) steps and lose the flip "
+        "phase of the tennis-racket motion at large dt; Tumble's `exact` follows the elliptic "
+        "solution. CSV: "
      << file_link(o, tcsv) << ".\n\n";
 
   // ---- bounce: first three apexes at dt = 1/60.

@@ -100,8 +100,8 @@ class MujocoWorld final : public PeerWorld {
       char buf[600];
       std::snprintf(buf, sizeof buf,
                     "MuJoCo 2.2 allocates efc_J (njmax × nv) and efc_AR (njmax × njmax) densely "
-                    "in mjData; the scene needs njmax ≥ %zu constraint rows (4 floor contacts "
-                    "per box once they land) with nv = %zu, i.e. %.0f GB, so it was not built "
+                    "in mjData; the scene needs njmax ≥ %zu constraint rows (up to 4 floor "
+                    "contacts per box on the floor) with nv = %zu, i.e. %.0f GB, so it was not built "
                     "(limit %.0f GB on this shared machine); a smaller njmax in <size> is no way "
                     "out: the rows of the landed boxes would not fit (MuJoCo warns "
                     "mjWARN_CNSTRFULL and drops constraints), so it would not be the same "
