@@ -374,7 +374,13 @@ Mat3 elliptic_flow(const Vec3& m0, double J1, double J2, double J3, double D1, d
   const double M = m0.norm();
   const double c = -M * (J3 - J1) * (J2 - J1) / (3.0 * p.lambda * J1 * J1 * (J3 - J2));
   const double psi = M * t / J1 + c * bracket;
-  return momentum_frame(m0).transpose() * rotation_about_z(psi) * momentum_frame(p.momentum(f));
+  // Rz(ψ) P(m(t)) as a rotation of the first two rows, not a 3×3 product.
+  Mat3 q = momentum_frame(p.momentum(f));
+  const double cos_psi = std::cos(psi), sin_psi = std::sin(psi);
+  const Eigen::RowVector3d e1 = q.row(0), e2 = q.row(1);
+  q.row(0) = cos_psi * e1 - sin_psi * e2;
+  q.row(1) = sin_psi * e1 + cos_psi * e2;
+  return momentum_frame(m0).transpose() * q;
 }
 
 Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
