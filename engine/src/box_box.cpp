@@ -11,6 +11,9 @@ namespace {
 // face from step to step, so feature ids and the warm-started impulses persist.
 constexpr double kFaceTolerance = 1e-4;
 constexpr double kEdgeTolerance = 5e-4;
+// ... plus this fraction of the smaller box's least half extent: an edge axis close to a face
+// normal must beat it clearly, or a box tilted on a face would get one edge point and rock.
+constexpr double kEdgeRelativeTolerance = 0.02;
 constexpr int kMaxClipped = 8;
 // A vertex of the incident face this far outside a side plane of the reference face still
 // counts as inside (m). Equal boxes stacked flush have their vertices exactly on those
@@ -146,6 +149,49 @@ int reduce_to_four(const std::array<ManifoldPoint, kMaxClipped>& in, int n, cons
   return 4;
 }
 
+/// Edge–edge case: the closest points of edge i of A and edge j of B along the axis
+/// a_i × b_j. Returns false when the closest points fall at an end of either edge: the edges
+/// do not cross, the contact is really a vertex or face one, and the face case handles it.
+bool edge_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                  const BodyConstants& cb, int edge_i, int edge_j, const Vec3& axis,
+                  BoxManifold& m) {
+  const Vec3& ha = ca.half_extents;
+  const Vec3& hb = cb.half_extents;
+  Vec3 n = axis;
+  if (n.dot(b.x - a.x) < 0.0) n = -n;
+  // The edge of A farthest along n and the edge of B farthest along −n.
+  Vec3 pa = a.x, pb = b.x;
+  std::uint32_t signs = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (k != edge_i) {
+      const double s = a.R.col(k).dot(n) > 0.0 ? 1.0 : -1.0;
+      pa += s * ha(k) * a.R.col(k);
+      signs |= (s > 0.0 ? 1u : 0u) << k;
+    }
+    if (k != edge_j) {
+      const double s = b.R.col(k).dot(n) < 0.0 ? 1.0 : -1.0;
+      pb += s * hb(k) * b.R.col(k);
+      signs |= (s > 0.0 ? 1u : 0u) << (3 + k);
+    }
+  }
+  // Closest points of the lines pa + s u and pb + t w (Ericson §5.1.8).
+  const Vec3 u = a.R.col(edge_i), w = b.R.col(edge_j);
+  const Vec3 r = pa - pb;
+  const double uw = u.dot(w), ur = u.dot(r), wr = w.dot(r);
+  const double denom = 1.0 - uw * uw;
+  if (denom <= 1e-12) return false;
+  const double s = (uw * wr - ur) / denom;
+  const double t = wr + s * uw;
+  if (std::abs(s) > ha(edge_i) || std::abs(t) > hb(edge_j)) return false;
+  const Vec3 qa = pa + s * u, qb = pb + t * w;
+  m.normal = n;
+  m.count = 1;
+  m.points[0].position = 0.5 * (qa + qb);
+  m.points[0].separation = (qb - qa).dot(n);
+  m.points[0].id = (1u << 31) | (static_cast<std::uint32_t>(edge_i * 3 + edge_j) << 8) | signs;
+  return true;
+}
+
 }  // namespace
 
 // Separating-axis test for oriented boxes (Gottschalk, Lin & Manocha, "OBBTree", SIGGRAPH
@@ -199,42 +245,12 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
   }
 
   const double best_face = std::max(best_a, best_b);
-  if (edge_i >= 0 && best_edge > best_face + kEdgeTolerance) {
-    Vec3 n = edge_axis;
-    if (n.dot(d) < 0.0) n = -n;
-    // The edge of A farthest along n and the edge of B farthest along −n.
-    Vec3 pa = a.x, pb = b.x;
-    std::uint32_t signs = 0;
-    for (int k = 0; k < 3; ++k) {
-      if (k != edge_i) {
-        const double s = a.R.col(k).dot(n) > 0.0 ? 1.0 : -1.0;
-        pa += s * ha(k) * a.R.col(k);
-        signs |= (s > 0.0 ? 1u : 0u) << k;
-      }
-      if (k != edge_j) {
-        const double s = b.R.col(k).dot(n) < 0.0 ? 1.0 : -1.0;
-        pb += s * hb(k) * b.R.col(k);
-        signs |= (s > 0.0 ? 1u : 0u) << (3 + k);
-      }
-    }
-    // Closest points of the lines pa + s u and pb + t w (Ericson §5.1.8), clamped to the edges.
-    const Vec3 u = a.R.col(edge_i), w = b.R.col(edge_j);
-    const Vec3 r = pa - pb;
-    const double uw = u.dot(w), ur = u.dot(r), wr = w.dot(r);
-    const double denom = 1.0 - uw * uw;
-    double s = denom > 1e-12 ? (uw * wr - ur) / denom : 0.0;
-    s = std::clamp(s, -ha(edge_i), ha(edge_i));
-    double t = std::clamp(wr + s * uw, -hb(edge_j), hb(edge_j));
-    s = std::clamp(t * uw - ur, -ha(edge_i), ha(edge_i));
-    const Vec3 qa = pa + s * u, qb = pb + t * w;
-    m.normal = n;
-    m.count = 1;
-    m.points[0].position = 0.5 * (qa + qb);
-    m.points[0].separation = (qb - qa).dot(n);
-    m.points[0].id = (1u << 31) | (static_cast<std::uint32_t>(edge_i * 3 + edge_j) << 8) | signs;
-    if (m.points[0].separation >= margin) m.count = 0;
+  const double edge_tolerance =
+      kEdgeTolerance + kEdgeRelativeTolerance * std::min(ha.minCoeff(), hb.minCoeff());
+  if (edge_i >= 0 && best_edge > best_face + edge_tolerance &&
+      edge_contact(a, ca, b, cb, edge_i, edge_j, edge_axis, m) && m.points[0].separation < margin)
     return m;
-  }
+  m = BoxManifold{};
 
   std::array<ManifoldPoint, kMaxClipped> clipped{};
   int n = 0;

@@ -365,9 +365,11 @@ void Solver::solve_position(Contact& c, const SolverSettings& s, double dt) {
   SolverBody* b = body(c.b);
   for (int i = 0; i < c.count; ++i) {
     ContactPoint& p = c.points[i];
-    const double depth = -p.separation - s.slop;
-    if (depth <= 0.0 && p.pseudo_impulse == 0.0) continue;
-    const double target = s.position_gain * std::max(depth, 0.0) / dt;
+    // Pseudo velocities obey the contacts too: a touching point may not be pushed deeper by
+    // the correction of another contact (a box pressed into the floor by the one above it).
+    const double target = p.separation > 0.0
+                              ? -p.separation / dt
+                              : s.position_gain * std::max(-p.separation - s.slop, 0.0) / dt;
     const double vn = (pseudo_velocity(b, p.rb) - pseudo_velocity(a, p.ra)).dot(c.normal);
     const double next = std::max(0.0, p.pseudo_impulse + p.normal_mass * (target - vn));
     const double delta = next - p.pseudo_impulse;

@@ -151,11 +151,18 @@ bool find_contacts(ContactState& k, std::span<Body> bodies, const WorldDef& w, d
   // load and the floor in one consistent set of impulses. Floor contacts go first: Gauss–
   // Seidel then carries the support up the stack within one sweep.
   if (w.floor) {
+    // A body struck from above can be driven down faster than it moves now: its floor margin
+    // also covers the speed of the fastest body touching it.
+    k.reach.assign(bodies.size(), 0.0);
+    for (const Contact& c : k.contacts) {
+      k.reach[c.a] = std::max(k.reach[c.a], point_speed_bound(bodies[c.b]));
+      k.reach[c.b] = std::max(k.reach[c.b], point_speed_bound(bodies[c.a]));
+    }
     std::vector<Contact> floor;
     for (std::uint32_t id : k.solver_bodies) {
       const Body& b = bodies[id];
       Contact c;
-      const double margin = kSpeculativeDistance + dt * point_speed_bound(b);
+      const double margin = kSpeculativeDistance + dt * (point_speed_bound(b) + k.reach[id]);
       if (floor_contact(b.s, b.c, id, w.floor->height, margin, c) > 0) floor.push_back(c);
     }
     k.contacts.insert(k.contacts.begin(), floor.begin(), floor.end());

@@ -30,6 +30,7 @@ struct ContactState {
   std::vector<std::vector<std::uint32_t>> islands;
   std::vector<std::uint32_t> solver_bodies;
   std::vector<BodyState> before;
+  std::vector<double> reach;  ///< Fastest neighbour of each body, m/s.
   std::vector<std::int32_t> island_of, solver_index;
   UnionFind sets;
   SolverSettings settings;
