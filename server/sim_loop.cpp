@@ -85,14 +85,18 @@ void SimLoop::advance() {
     anchor_sim_ -= dropped;
     metrics_.add_dropped_time(dropped);
   }
-  while (sim_clock(now) > world_->time()) step_once();
+  // Commands must not wait behind a long catch-up: past the budget, return to the queue (the
+  // next call drops what is still owed beyond kMaxCatchUp).
+  const Clock::time_point budget_end = now + kStepBudget;
+  while (sim_clock(now) > world_->time() && Clock::now() < budget_end) step_once();
 }
 
 // The real-time factor compares, over the last kRtfWindow seconds, the sim time at which
 // steps started with the wall time at which they started.
 void SimLoop::step_once() {
   const Clock::time_point t0 = Clock::now();
-  rtf_samples_.emplace_back(t0, world_->time());
+  if (rtf_samples_.empty() || t0 - rtf_samples_.back().first >= std::chrono::milliseconds(1))
+    rtf_samples_.emplace_back(t0, world_->time());
   while (rtf_samples_.size() > 2 && seconds(t0 - rtf_samples_[1].first) >= kRtfWindow)
     rtf_samples_.pop_front();
   const double wall = seconds(t0 - rtf_samples_.front().first);

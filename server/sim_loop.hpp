@@ -28,6 +28,8 @@ class SimLoop {
   /// Most simulated time (s) the loop catches up in one go; beyond that it drops time and
   /// the real-time factor falls below 1 instead of spiralling.
   static constexpr double kMaxCatchUp = 0.1;
+  /// Longest the loop steps (wall time) before it looks at the command queue again.
+  static constexpr std::chrono::milliseconds kStepBudget{20};
   /// Wall-time window (s) over which the real-time factor is measured.
   static constexpr double kRtfWindow = 2.0;
   /// Shortest window (s) that updates it; until then (after a start, resume or reset) the

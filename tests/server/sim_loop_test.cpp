@@ -34,6 +34,29 @@ TEST(SimLoop, RealTimeFactorIsOne) {
   EXPECT_NEAR(s->time, 1.5, 0.05);
 }
 
+TEST(SimLoop, FallingBehindDropsTimeAndStaysResponsive) {
+  Metrics metrics;
+  // 100 boxes stepped every 0.1 µs cannot be kept up with: the loop must drop time, not
+  // spiral.
+  Scene scene = load_scene("many");
+  scene.world.dt = 1e-7;
+  SimLoop sim(scene, metrics);
+  sim.start();
+  std::this_thread::sleep_for(1000ms);
+  const auto s = sim.latest();
+  EXPECT_LT(s->real_time_factor, 0.9);
+  EXPECT_GT(s->real_time_factor, 0.0);
+  EXPECT_LT(s->time, 0.95);
+  const std::string text = metrics.render(*s, 0);
+  const std::string name = "\ntumble_dropped_sim_seconds_total ";
+  const auto at = text.find(name);
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_GT(std::stod(text.substr(at + name.size())), 0.5) << text.substr(at, 60);
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(run(sim, PauseCommand{}).status, 200u);
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 200ms);
+}
+
 TEST(SimLoop, PausedItStopsAndStepsOnRequest) {
   Metrics metrics;
   SimLoop sim(load_scene("seed"), metrics);
