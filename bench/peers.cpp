@@ -327,10 +327,11 @@ void run_peers(const Options& o) {
     for (const auto& [what, why] : refused) md << "- " << what << ": " << why << ".\n";
     md << '\n';
   }
-  md << "What the tables show: Bullet and ODE run a general constraint solver and broadphase "
-        "for every body-step and MuJoCo a soft-contact solve over the whole model, which "
-        "Tumble (bodies that meet only the floor here) does not need; the ratio is the price "
-        "of that generality on this scene, not a verdict on the engines. In `skip` the peers "
+  md << "What the tables show: Bullet and ODE run a general iterative constraint solver over "
+        "every contact and MuJoCo a soft-contact solve over the whole model, while Tumble, "
+        "after its sweep-and-prune broad phase finds no touching pairs, answers each box's "
+        "floor contact on its own exact path; the ratio is the price of that generality on "
+        "these scenes, not a verdict on the engines. In `skip` the peers "
         "with sleeping (Bullet after 2 s, ODE's auto-disable) cannot sleep in the first "
         "steps, and MuJoCo 2.2 has no sleeping.\n\n";
   write_section(o, "peers", md.str());

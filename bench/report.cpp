@@ -74,8 +74,11 @@ std::string closing_note(const Options& o, const std::map<std::string, std::stri
     << " ms for the 10 alone), goal ≤ 0.2 ms: " << verdict(skip, 0.2)
     << ". First step " << fmt(number(v, "skip.first_step_ms")) << " ms ("
     << fmt(number(v, "skip.first_step_ms_alone")) << " ms alone) with " << fmt(awake1)
-    << " bodies awake after it; cost following the awake bodies from the first step: "
-    << (std::isnan(awake1) ? "**not measured**" : awake1 <= 10.0 ? "**met**" : "**not met**")
+    << " bodies awake after it; cost following the awake bodies from the first step (only "
+       "the 10 awake, and the first step itself within 0.2 ms): "
+    << (std::isnan(awake1) ? "**not measured**"
+        : awake1 <= 10.0 && number(v, "skip.first_step_ms") <= 0.2 ? "**met**"
+                                                                      : "**not met**")
     << ".\n";
   s << "- **`tumble` orientation error at dt = 1/30** (geodesic angle after 20 s, rad):\n\n";
   std::vector<std::vector<std::string>> rows;

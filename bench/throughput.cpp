@@ -206,9 +206,11 @@ void run_throughput(const Options& o) {
                   "ns per awake body-step", "awake", "peak RSS (MB)", "bytes per body"},
                  rows)
      << "\nWhat it shows: the plot draws ns per body-step against N on log axes (left "
-        "axis) and the peak resident memory (right axis). The cost per body-step should be "
-        "flat in N (each body meets only the floor), so a rise at large N is memory traffic "
-        "and the rise at small N is fixed per-step overhead not yet amortised. The gap between "
+        "axis) and the peak resident memory (right axis). The integration and floor contact "
+        "of a body do not depend on the others, so that part is flat in N; what grows with N "
+        "is the broad phase (sweep and prune along x: on this square grid every box's x "
+        "interval overlaps those of the √N boxes in its column, so the pair tests grow as "
+        "N^1.5) and memory traffic. The gap between "
         "the cube and box curves is the price of the elliptic-function flow of a general "
         "box against the one closed-form rotation of a cube; the gap between a shape's "
         "first-0.5-s curve and its whole-run curve is the price of impacts and floor contact "
