@@ -72,7 +72,9 @@ const json& required(const json& j, const char* key) {
   return *it;
 }
 
-Vec3 finite_vec3(const json& j, const char* field) {
+// Three finite numbers, each within ±limit (finite but huge values such as 1e308 would
+// only make the body go non-finite a step later).
+Vec3 finite_vec3(const json& j, const char* field, double limit) {
   if (!j.is_array() || j.size() != 3)
     throw Refusal{400, "expected an array of 3 numbers", field};
   Vec3 v;
@@ -80,9 +82,16 @@ Vec3 finite_vec3(const json& j, const char* field) {
     if (!j[i].is_number()) throw Refusal{400, "expected an array of 3 numbers", field};
     v[i] = j[i].get<double>();
     if (!std::isfinite(v[i])) throw Refusal{400, "numbers must be finite", field};
+    if (std::abs(v[i]) > limit)
+      throw Refusal{400, "each component must be within ±" + json(limit).dump(), field};
   }
   return v;
 }
+
+/// Largest impulse component accepted, N·s, and largest point coordinate, m (the scene's
+/// own position bound).
+constexpr double kMaxImpulse = 1e6;
+constexpr double kMaxPoint = 1e6;
 
 // ---- Commands ------------------------------------------------------------------------
 
@@ -161,8 +170,8 @@ void post_impulse(const Request& req, ServerContext& ctx, const Reply& reply) {
   } else {
     throw Refusal{400, "body must be an index or a name", "body"};
   }
-  c.impulse = finite_vec3(required(body, "impulse"), "impulse");
-  if (body.contains("point")) c.point = finite_vec3(body["point"], "point");
+  c.impulse = finite_vec3(required(body, "impulse"), "impulse", kMaxImpulse);
+  if (body.contains("point")) c.point = finite_vec3(body["point"], "point", kMaxPoint);
   submit(ctx, req, std::move(c), reply);
 }
 
