@@ -18,47 +18,119 @@ Aabb swept_aabb(const BodyState& s, const BodyConstants& c, const Vec3& gravity,
   return {s.x - grow, s.x + grow};
 }
 
+namespace {
+
+// The sweep runs along a fixed generic direction rather than x: scenes are often laid out on
+// a grid in x and z, and along x every box of a column would overlap every other one, so the
+// sweep would cost O(n √n). Along an irrational mix of the axes the interval starts of a grid
+// are all distinct and each box meets only its true neighbours.
+const Vec3 kSweep = Vec3(1.0, 0.1234, 0.6180339887).normalized();
+
+double interval_start(const Aabb& b) {
+  const Vec3 c = 0.5 * (b.lo + b.hi), h = 0.5 * (b.hi - b.lo);
+  return c.dot(kSweep) - h.dot(kSweep.cwiseAbs());
+}
+
+double interval_end(const Aabb& b) {
+  const Vec3 c = 0.5 * (b.lo + b.hi), h = 0.5 * (b.hi - b.lo);
+  return c.dot(kSweep) + h.dot(kSweep.cwiseAbs());
+}
+
+bool overlap(const Aabb& a, const Aabb& b) {
+  return !(b.lo.x() > a.hi.x() || a.lo.x() > b.hi.x() || b.lo.y() > a.hi.y() ||
+           a.lo.y() > b.hi.y() || b.lo.z() > a.hi.z() || a.lo.z() > b.hi.z());
+}
+
+void add_pair(std::vector<BodyPair>& pairs, std::uint32_t a, std::uint32_t b) {
+  pairs.emplace_back(std::min(a, b), std::max(a, b));
+}
+
+/// Keeps `list` = the bodies with flag set, sorted by start (insertion sort from last order).
+void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& start) {
+  auto less = [&](std::uint32_t a, std::uint32_t b) {
+    return start[a] < start[b] || (start[a] == start[b] && a < b);
+  };
+  for (std::size_t i = 1; i < list.size(); ++i) {
+    const std::uint32_t key = list[i];
+    std::size_t j = i;
+    while (j > 0 && less(key, list[j - 1])) {
+      list[j] = list[j - 1];
+      --j;
+    }
+    list[j] = key;
+  }
+}
+
+}  // namespace
+
 // Sweep and prune (Baraff 1992, "Dynamic simulation of non-penetrating rigid bodies", §7.4;
-// Ericson, Real-Time Collision Detection, §7.5.1): sort the boxes by their lower x bound and
-// sweep, testing each box only against those whose x interval is still open. Bodies move
-// little between steps, so the previous order is almost sorted and insertion sort is about
-// linear; a scene whose boxes never overlap finds no pair and the narrow phase never runs.
+// Ericson, Real-Time Collision Detection, §7.5.1): sort the boxes by where their projection
+// on the sweep direction starts and sweep, testing each box only against those whose
+// interval is still open. Bodies move little between steps, so last step's order is almost
+// sorted and insertion sort is about linear. Sleeping bodies do not move: they are sorted
+// once per change of the sleeping set, and each awake box finds the sleeping ones it may
+// touch by binary search over that list.
 void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
-                std::span<const std::uint8_t> candidate, std::vector<std::uint32_t>& order,
+                std::span<const std::uint8_t> candidate, SweepScratch& scratch,
                 std::vector<BodyPair>& pairs) {
   pairs.clear();
   const std::size_t n = boxes.size();
-  if (order.size() != n) {
-    order.resize(n);
-    for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-  }
-  auto less = [&](std::uint32_t a, std::uint32_t b) {
-    const double la = boxes[a].lo.x(), lb = boxes[b].lo.x();
-    return la < lb || (la == lb && a < b);
-  };
-  for (std::size_t i = 1; i < n; ++i) {
-    const std::uint32_t key = order[i];
-    std::size_t j = i;
-    while (j > 0 && less(key, order[j - 1])) {
-      order[j] = order[j - 1];
-      --j;
-    }
-    order[j] = key;
-  }
+  scratch.start.resize(n);
+  std::uint64_t signature = 1469598103934665603ull;  // FNV-1a over the sleeping set
+  std::size_t awake_count = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint32_t a = order[i];
-    if (!candidate[a]) continue;
-    const Aabb& ba = boxes[a];
-    for (std::size_t j = i + 1; j < n; ++j) {
-      const std::uint32_t b = order[j];
-      const Aabb& bb = boxes[b];
-      if (bb.lo.x() > ba.hi.x()) break;
-      if (!candidate[b] || !(active[a] || active[b])) continue;
-      if (bb.lo.y() > ba.hi.y() || ba.lo.y() > bb.hi.y() || bb.lo.z() > ba.hi.z() ||
-          ba.lo.z() > bb.hi.z())
-        continue;
-      pairs.emplace_back(std::min(a, b), std::max(a, b));
+    if (!candidate[i]) continue;
+    if (active[i]) {
+      scratch.start[i] = interval_start(boxes[i]);
+      ++awake_count;
+    } else {
+      signature = (signature ^ i) * 1099511628211ull;
     }
+  }
+  // The awake list keeps last step's order for the bodies still awake, then appends the rest.
+  std::vector<std::uint32_t>& awake = scratch.awake;
+  std::erase_if(awake, [&](std::uint32_t i) { return i >= n || !candidate[i] || !active[i]; });
+  if (awake.size() != awake_count) {
+    std::vector<std::uint8_t> listed(n, 0);
+    for (std::uint32_t i : awake) listed[i] = 1;
+    for (std::size_t i = 0; i < n; ++i)
+      if (candidate[i] && active[i] && !listed[i]) awake.push_back(static_cast<std::uint32_t>(i));
+  }
+  sort_by_start(awake, scratch.start);
+  if (signature != scratch.sleeping_signature) {
+    scratch.sleeping.clear();
+    scratch.sleeping_width = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!candidate[i] || active[i]) continue;
+      scratch.start[i] = interval_start(boxes[i]);
+      scratch.sleeping.push_back(static_cast<std::uint32_t>(i));
+      scratch.sleeping_width =
+          std::max(scratch.sleeping_width, interval_end(boxes[i]) - scratch.start[i]);
+    }
+    std::sort(scratch.sleeping.begin(), scratch.sleeping.end(),
+              [&](std::uint32_t a, std::uint32_t b) {
+                return scratch.start[a] < scratch.start[b] ||
+                       (scratch.start[a] == scratch.start[b] && a < b);
+              });
+    scratch.sleeping_signature = signature;
+  }
+  const std::vector<std::uint32_t>& sleeping = scratch.sleeping;
+  for (std::size_t i = 0; i < awake.size(); ++i) {
+    const std::uint32_t a = awake[i];
+    const Aabb& ba = boxes[a];
+    const double end = interval_end(ba);
+    for (std::size_t j = i + 1; j < awake.size(); ++j) {
+      const std::uint32_t b = awake[j];
+      if (scratch.start[b] > end) break;
+      if (overlap(ba, boxes[b])) add_pair(pairs, a, b);
+    }
+    // Sleeping boxes whose interval can overlap [start, end]: they start after
+    // start − widest and before end.
+    auto first = std::lower_bound(sleeping.begin(), sleeping.end(),
+                                  scratch.start[a] - scratch.sleeping_width,
+                                  [&](std::uint32_t s, double v) { return scratch.start[s] < v; });
+    for (auto it = first; it != sleeping.end() && scratch.start[*it] <= end; ++it)
+      if (overlap(ba, boxes[*it])) add_pair(pairs, a, *it);
   }
   std::sort(pairs.begin(), pairs.end());
 }

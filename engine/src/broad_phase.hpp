@@ -1,7 +1,8 @@
 #pragma once
-/// Broad phase: which pairs of bodies may touch during the next step. Sweep and prune on x
-/// over axis-aligned bounding boxes fattened by each body's motion. Pure functions over the
-/// caller's scratch buffers; thread-safe.
+/// Broad phase: which pairs of bodies may touch during the next step. Sweep and prune along a
+/// generic direction over axis-aligned bounding boxes fattened by each body's motion; sleeping
+/// bodies sit in a sorted list of their own that only awake bodies query. Pure functions over
+/// the caller's scratch buffers; thread-safe.
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -26,12 +27,22 @@ Aabb swept_aabb(const BodyState& s, const BodyConstants& c, const Vec3& gravity,
 /// A candidate pair of body indices, first < second.
 using BodyPair = std::pair<std::uint32_t, std::uint32_t>;
 
+/// Scratch kept between steps: the sweep orders of the awake and of the sleeping bodies.
+struct SweepScratch {
+  std::vector<std::uint32_t> awake;       ///< Awake candidates, sorted by their interval start.
+  std::vector<std::uint32_t> sleeping;    ///< Sleeping candidates, sorted likewise.
+  std::vector<double> start;              ///< Interval start of each body along the sweep.
+  std::uint64_t sleeping_signature = ~0ull;  ///< Which set `sleeping` was sorted for.
+  double sleeping_width = 0.0;            ///< Widest sleeping interval, m.
+};
+
 /// Every pair whose boxes overlap and of which at least one body is `active` (sleeping pairs
-/// stay asleep), in ascending (first, second) order. `order` is scratch: it keeps the last
-/// sort along x, so a scene that moves little re-sorts in about linear time (insertion sort).
-/// `candidate[i]` false leaves body i out entirely (frozen bodies).
+/// stay asleep), in ascending (first, second) order. `candidate[i]` false leaves body i out
+/// entirely (frozen bodies). Cost: the awake bodies re-sort in about linear time (insertion
+/// sort on last step's order); the sleeping ones are sorted only when their set changes and
+/// are found by binary search, so 10,000 sleeping boxes cost nothing per step.
 void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
-                std::span<const std::uint8_t> candidate, std::vector<std::uint32_t>& order,
+                std::span<const std::uint8_t> candidate, SweepScratch& scratch,
                 std::vector<BodyPair>& pairs);
 
 }  // namespace tumble

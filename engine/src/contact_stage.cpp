@@ -46,14 +46,18 @@ int collide(ContactState& k, std::span<Body> bodies, const WorldDef& w, double d
   for (std::size_t i = 0; i < n; ++i) {
     const Body& b = bodies[i];
     k.active[i] = b.activity == Activity::awake;
-    k.boxes[i] = swept_aabb(b.s, b.c, w.gravity, k.active[i] ? dt : 0.0,
-                            0.5 * kSpeculativeDistance);
+    // A sleeping body does not move: its box is computed once, when it is first seen asleep.
+    if (k.active[i] || !k.box_cached[i]) {
+      k.boxes[i] = swept_aabb(b.s, b.c, w.gravity, k.active[i] ? dt : 0.0,
+                              0.5 * kSpeculativeDistance);
+      k.box_cached[i] = !k.active[i];
+    }
     // A body about to go non-finite (an overflowing impulse) touches nothing: the floor-only
     // path freezes it after its step.
     k.candidate[i] = b.activity != Activity::frozen &&
                      std::isfinite(k.boxes[i].lo.sum() + k.boxes[i].hi.sum());
   }
-  find_pairs(k.boxes, k.active, k.candidate, k.order, k.pairs);
+  find_pairs(k.boxes, k.active, k.candidate, k.sweep, k.pairs);
   k.contacts.clear();
   int woken = 0;
   for (const BodyPair& p : k.pairs) {
@@ -94,6 +98,7 @@ void init_contact_state(ContactState& k, std::size_t body_count) {
   k.boxes.resize(body_count);
   k.active.resize(body_count);
   k.candidate.resize(body_count);
+  k.box_cached.assign(body_count, 0);
   k.in_solver.assign(body_count, 0);
 }
 

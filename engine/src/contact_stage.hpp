@@ -21,10 +21,11 @@ struct ContactState {
   std::vector<std::uint32_t> sleep_next;  ///< Ring of each sleeping island (self when alone).
   std::vector<Contact> previous;          ///< Last step's contacts (for warm starting).
   std::unordered_map<std::uint64_t, std::uint32_t> previous_index;  ///< Pair key → previous.
-  std::vector<std::uint32_t> order;       ///< Sweep-and-prune order along x.
+  SweepScratch sweep;                     ///< Sweep-and-prune orders kept between steps.
   // Per step.
   std::vector<Aabb> boxes;
   std::vector<std::uint8_t> active, candidate, in_solver;
+  std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
   std::vector<BodyPair> pairs, links;
   std::vector<Contact> contacts;
   std::vector<std::vector<std::uint32_t>> islands;
