@@ -39,6 +39,42 @@ double point_speed_bound(const Body& b) {
   return b.s.P.norm() * b.c.inv_mass + angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
 }
 
+bool contains(const Aabb& outer, const Aabb& inner) {
+  return (outer.lo.array() <= inner.lo.array()).all() && (inner.hi.array() <= outer.hi.array()).all();
+}
+
+bool overlaps(const Aabb& a, const Aabb& b) {
+  return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
+}
+
+// Pairs from fattened boxes, reused while every awake body stays inside its fat box and no
+// body changes activity (Box2D's fat AABBs, Catto 2019 "Dynamic bounding volume
+// hierarchies"): a falling box moves a few centimetres a step, so the sweep runs about once
+// every ten steps and the steps between only filter the cached pairs by the tight boxes.
+void broad_phase(ContactState& k, std::span<const Body> bodies) {
+  const std::size_t n = bodies.size();
+  bool rebuild = k.fat.size() != n;
+  std::uint64_t signature = 1469598103934665603ull;
+  for (std::size_t i = 0; i < n && !rebuild; ++i) {
+    signature = (signature ^ (k.active[i] | (k.candidate[i] << 1))) * 1099511628211ull;
+    if (k.active[i] && !contains(k.fat[i], k.boxes[i])) rebuild = true;
+  }
+  if (rebuild || signature != k.fat_signature) {
+    k.fat.resize(n);
+    signature = 1469598103934665603ull;
+    for (std::size_t i = 0; i < n; ++i) {
+      signature = (signature ^ (k.active[i] | (k.candidate[i] << 1))) * 1099511628211ull;
+      const double margin = k.active[i] ? 0.5 * bodies[i].c.bounding_radius : 0.0;
+      k.fat[i] = {k.boxes[i].lo.array() - margin, k.boxes[i].hi.array() + margin};
+    }
+    k.fat_signature = signature;
+    find_pairs(k.fat, k.active, k.candidate, k.sweep, k.fat_pairs);
+  }
+  k.pairs.clear();
+  for (const BodyPair& p : k.fat_pairs)
+    if (overlaps(k.boxes[p.first], k.boxes[p.second])) k.pairs.push_back(p);
+}
+
 /// Broad and narrow phase over the current activity flags; fills k.contacts with the
 /// body–body contacts. Returns how many sleeping bodies a contact touched (and woke).
 int collide(ContactState& k, std::span<Body> bodies, const WorldDef& w, double dt) {
@@ -46,18 +82,18 @@ int collide(ContactState& k, std::span<Body> bodies, const WorldDef& w, double d
   for (std::size_t i = 0; i < n; ++i) {
     const Body& b = bodies[i];
     k.active[i] = b.activity == Activity::awake;
-    // A sleeping body does not move: its box is computed once, when it is first seen asleep.
-    if (k.active[i] || !k.box_cached[i]) {
-      k.boxes[i] = swept_aabb(b.s, b.c, w.gravity, k.active[i] ? dt : 0.0,
-                              0.5 * kSpeculativeDistance);
-      k.box_cached[i] = !k.active[i];
-    }
+    // A sleeping body does not move: its box (and candidacy) is computed once, when it is
+    // first seen asleep, so 10,000 sleeping boxes cost a flag test each per step.
+    if (!k.active[i] && k.box_cached[i]) continue;
+    k.boxes[i] = swept_aabb(b.s, b.c, w.gravity, k.active[i] ? dt : 0.0,
+                            0.5 * kSpeculativeDistance);
+    k.box_cached[i] = !k.active[i];
     // A body about to go non-finite (an overflowing impulse) touches nothing: the floor-only
     // path freezes it after its step.
     k.candidate[i] = b.activity != Activity::frozen &&
                      std::isfinite(k.boxes[i].lo.sum() + k.boxes[i].hi.sum());
   }
-  find_pairs(k.boxes, k.active, k.candidate, k.sweep, k.pairs);
+  broad_phase(k, bodies);
   k.contacts.clear();
   int woken = 0;
   for (const BodyPair& p : k.pairs) {
@@ -119,8 +155,9 @@ bool find_contacts(ContactState& k, std::span<Body> bodies, const WorldDef& w, d
   std::fill(k.in_solver.begin(), k.in_solver.end(), 0);
   k.contacts.clear();
   if (bodies.size() < 2) return false;
-  bool any_awake = false;
-  for (const Body& b : bodies) any_awake = any_awake || b.activity == Activity::awake;
+  const bool any_awake = std::any_of(bodies.begin(), bodies.end(), [](const Body& b) {
+    return b.activity == Activity::awake;
+  });
   if (!any_awake) {
     k.previous.clear();
     k.previous_index.clear();

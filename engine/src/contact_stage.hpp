@@ -26,6 +26,9 @@ struct ContactState {
   std::vector<Aabb> boxes;
   std::vector<std::uint8_t> active, candidate, in_solver;
   std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
+  std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
+  std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
+  std::uint64_t fat_signature = 0;       ///< Activity flags the fat pairs were found for.
   std::vector<BodyPair> pairs, links;
   std::vector<Contact> contacts;
   std::vector<std::vector<std::uint32_t>> islands;
