@@ -90,13 +90,21 @@ void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   // The awake list keeps last step's order for the bodies still awake, then appends the rest.
   std::vector<std::uint32_t>& awake = scratch.awake;
   std::erase_if(awake, [&](std::uint32_t i) { return i >= n || !candidate[i] || !active[i]; });
-  if (awake.size() != awake_count) {
+  const std::size_t kept = awake.size();
+  if (kept != awake_count) {
     std::vector<std::uint8_t> listed(n, 0);
     for (std::uint32_t i : awake) listed[i] = 1;
     for (std::size_t i = 0; i < n; ++i)
       if (candidate[i] && active[i] && !listed[i]) awake.push_back(static_cast<std::uint32_t>(i));
   }
-  sort_by_start(awake, scratch.start);
+  if (awake.size() - kept > awake.size() / 8) {
+    // Many newcomers (the first step, a mass wake-up): a full sort, not insertion.
+    std::sort(awake.begin(), awake.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return scratch.start[a] < scratch.start[b] || (scratch.start[a] == scratch.start[b] && a < b);
+    });
+  } else {
+    sort_by_start(awake, scratch.start);
+  }
   if (signature != scratch.sleeping_signature) {
     scratch.sleeping.clear();
     scratch.sleeping_width = 0.0;
