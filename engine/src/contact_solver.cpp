@@ -5,14 +5,13 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "active_set.hpp"
 #include "floor_contact.hpp"
 
 namespace tumble {
 namespace {
 
-using PointMatrix =
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxContactPoints, kMaxContactPoints>;
-using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxContactPoints, 1>;
+static_assert(kMaxContactPoints <= kMaxActiveSetPoints);
 
 /// Velocities of a body during the solve (I⁻¹ fixed at the start of the step).
 struct SolverBody {
@@ -30,57 +29,6 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   const Vec3 ref = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
   t1 = n.cross(ref).normalized();
   t2 = n.cross(t1);
-}
-
-// Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
-// dynamic simulation of non-penetrating rigid bodies", §4, with equality targets): every
-// active point leaves with v⁺ₙ = target and a non-negative impulse; a point that would pull
-// is dropped, a passive one that would approach is added. K is singular for four coplanar
-// points (a face has three normal degrees of freedom), so each solve uses the pseudo-inverse;
-// rigid-body targets are then consistent and a flat landing stays flat.
-PointVector solve_active_set(const PointMatrix& K, const PointVector& vn, const PointVector& target) {
-  const int n = static_cast<int>(vn.size());
-  std::array<bool, kMaxContactPoints> active{};
-  for (int i = 0; i < n; ++i) active[i] = vn(i) < target(i);
-  PointVector impulse = PointVector::Zero(n);
-  for (int iter = 0; iter < 4 * kMaxContactPoints; ++iter) {
-    std::array<int, kMaxContactPoints> act{};
-    int m = 0;
-    for (int i = 0; i < n; ++i)
-      if (active[i]) act[m++] = i;
-    impulse.setZero();
-    if (m > 0) {
-      PointMatrix Ka(m, m);
-      PointVector rhs(m);
-      for (int r = 0; r < m; ++r) {
-        rhs(r) = target(act[r]) - vn(act[r]);
-        for (int s = 0; s < m; ++s) Ka(r, s) = K(act[r], act[s]);
-      }
-      Eigen::SelfAdjointEigenSolver<PointMatrix> eig(Ka);
-      const PointVector lambda = eig.eigenvalues();
-      const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-      PointVector y = eig.eigenvectors().transpose() * rhs;
-      for (int r = 0; r < m; ++r) y(r) = std::abs(lambda(r)) > cutoff ? y(r) / lambda(r) : 0.0;
-      const PointVector ja = eig.eigenvectors() * y;
-      for (int r = 0; r < m; ++r) impulse(act[r]) = ja(r);
-    }
-    int worst = -1;
-    double worst_value = -1e-14;
-    for (int i = 0; i < n; ++i)
-      if (active[i] && impulse(i) < worst_value) worst = i, worst_value = impulse(i);
-    if (worst >= 0) {
-      active[worst] = false;
-      continue;
-    }
-    const PointVector after = vn.head(n) + K * impulse;
-    worst_value = -1e-12;
-    for (int i = 0; i < n; ++i)
-      if (!active[i] && after(i) - target(i) < worst_value)
-        worst = i, worst_value = after(i) - target(i);
-    if (worst < 0) break;
-    active[worst] = true;
-  }
-  return impulse;
 }
 
 class Solver {
@@ -221,7 +169,8 @@ int Solver::impact(Contact& c, const Vec3& gravity, double dt) {
   sub.count = n;
   for (int i = 0; i < n; ++i) sub.points[i] = c.points[idx[i]];
   const PointMatrix K = normal_matrix_of(sub, a, b);
-  const PointVector impulse = solve_active_set(K, vn.head(n), target.head(n));
+  ActiveSetCache cache(K);
+  const PointVector impulse = solve_active_set(cache, vn.head(n), target.head(n));
   for (int i = 0; i < n; ++i) {
     if (impulse(i) <= 0.0) continue;
     const ContactPoint& p = c.points[idx[i]];
@@ -346,7 +295,8 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
       approaching = approaching || vn(k) < target(k) - 1e-9;
     }
     if (!approaching) continue;
-    const PointVector impulse = solve_active_set(normal_matrix_of(c, a, b), vn, target);
+    ActiveSetCache cache(normal_matrix_of(c, a, b));
+    const PointVector impulse = solve_active_set(cache, vn, target);
     for (int k = 0; k < n; ++k)
       if (impulse(k) > 0.0) apply(a, b, c.points[k].ra, c.points[k].rb, impulse(k) * c.normal);
   }

@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <boost/math/tools/toms748_solve.hpp>
 
+#include "active_set.hpp"
 #include "integrators.hpp"
 
 namespace tumble {
@@ -18,8 +19,6 @@ constexpr double kSimultaneous = 1e-9;   // m: vertices this close to the lowest
 constexpr double kContactBand = 1e-6;    // m: vertices this close to the floor are touching.
 constexpr int kMaxPoints = 8;
 
-using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxPoints, kMaxPoints>;
-using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxPoints, 1>;
 
 /// Body-frame offsets and world velocities of the vertices touching the floor.
 struct ContactSet {
@@ -70,104 +69,28 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
   return target;
 }
 
-/// K⁺ of a symmetric positive semi-definite K, dropping eigenvalues below 1e-12 of the
-/// largest (the null space of a flat face's four contacts).
-PointMatrix pseudo_inverse(const PointMatrix& K) {
-  const Eigen::Index m = K.rows();
-  if (m == 1) return PointMatrix::Constant(1, 1, 1.0 / K(0, 0));
-  Eigen::SelfAdjointEigenSolver<PointMatrix> eig(K);
-  const PointVector lambda = eig.eigenvalues();
-  const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-  PointVector inv(m);
-  for (Eigen::Index a = 0; a < m; ++a) inv(a) = std::abs(lambda(a)) > cutoff ? 1.0 / lambda(a) : 0.0;
-  return eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+/// The contacts' normal-impulse matrix K (Kᵢⱼ = normal velocity change at i per unit impulse
+/// at j); I⁻¹ is fixed within one impulse exchange.
+PointMatrix normal_matrix(const Kinematics& k, const ContactSet& set) {
+  const Vec3 up = Vec3::UnitY();
+  PointMatrix K(set.count, set.count);
+  for (int i = 0; i < set.count; ++i)
+    for (int j = 0; j < set.count; ++j)
+      K(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
+  return K;
 }
 
-/// The contacts' normal-impulse matrix K (Kᵢⱼ = normal velocity change at i per unit impulse
-/// at j) with the pseudo-inverses of the active subsets met so far: within one impulse
-/// exchange I⁻¹ is fixed, so the friction rounds that re-solve the normals reuse them.
-class NormalSystem {
- public:
-  NormalSystem(const Kinematics& k, const ContactSet& set) : n_(set.count), K_(n_, n_) {
-    const Vec3 up = Vec3::UnitY();
-    for (int i = 0; i < n_; ++i)
-      for (int j = 0; j < n_; ++j)
-        K_(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
-  }
-  const PointMatrix& K() const { return K_; }
-  /// K⁺ restricted to the contacts in `mask` (bit i = contact i), listed in idx[0..m).
-  const PointMatrix& inverse(unsigned mask, const std::array<int, kMaxPoints>& idx, int m) {
-    for (int c = 0; c < cached_; ++c)
-      if (masks_[c] == mask) return inverses_[c];
-    PointMatrix Ka(m, m);
-    for (int a = 0; a < m; ++a)
-      for (int b = 0; b < m; ++b) Ka(a, b) = K_(idx[a], idx[b]);
-    const int slot = cached_ < kCache ? cached_++ : (next_++ % kCache);
-    masks_[slot] = mask;
-    inverses_[slot] = pseudo_inverse(Ka);
-    return inverses_[slot];
-  }
-
- private:
-  static constexpr int kCache = 4;
-  int n_;
-  PointMatrix K_;
-  int cached_ = 0, next_ = 0;
-  std::array<unsigned, kCache> masks_{};
-  std::array<PointMatrix, kCache> inverses_;
-};
-
-// Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
-// dynamic simulation of non-penetrating rigid bodies", §4, with equality targets).
-// Every active contact i leaves with v⁺ₙ = targetᵢ and a non-negative impulse; a contact
-// that would pull is dropped, a passive one that would approach is added. K is singular for
-// four coplanar contacts (a flat face has three normal degrees of freedom), so the solve
-// uses the pseudo-inverse; rigid-body targets are then consistent and a flat landing stays
-// flat. With e = 1 every active contact reverses its normal velocity, which conserves kinetic
-// energy exactly: ΔT = Σ jᵢ (v⁻ᵢ + v⁺ᵢ)/2 = 0.
-Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, NormalSystem& system,
+/// Applies the active-set normal impulses (active_set.hpp) and returns them per contact.
+Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, ActiveSetCache& system,
                       const Impulses& target) {
   const int n = set.count;
-  const PointMatrix& K = system.K();
-  PointVector vn(n);
-  const Vec3 up = Vec3::UnitY();
-  for (int i = 0; i < n; ++i) vn(i) = k.point_velocity(set.r[i]).y();
-  std::array<bool, kMaxPoints> active{};
-  for (int i = 0; i < n; ++i) active[i] = vn(i) < target[i] - 1e-15;
-  PointVector impulse = PointVector::Zero(n);
-  for (int iter = 0; iter < 4 * kMaxPoints; ++iter) {
-    std::array<int, kMaxPoints> idx{};
-    int m = 0;
-    unsigned mask = 0;
-    for (int i = 0; i < n; ++i)
-      if (active[i]) idx[m++] = i, mask |= 1u << i;
-    impulse.setZero();
-    if (m > 0) {
-      PointVector b(m);
-      for (int a = 0; a < m; ++a) b(a) = target[idx[a]] - vn(idx[a]);
-      const PointVector ja = system.inverse(mask, idx, m) * b;
-      for (int a = 0; a < m; ++a) impulse(idx[a]) = ja(a);
-    }
-    // Drop the most negative impulse, else add the most violated passive contact.
-    int worst = -1;
-    double worst_value = -1e-14;
-    for (int i = 0; i < n; ++i)
-      if (active[i] && impulse(i) < worst_value) worst = i, worst_value = impulse(i);
-    if (worst >= 0) {
-      active[worst] = false;
-      continue;
-    }
-    const PointVector after = vn + K * impulse;
-    worst_value = -1e-12;
-    for (int i = 0; i < n; ++i)
-      if (!active[i] && after(i) - target[i] < worst_value) worst = i, worst_value = after(i) - target[i];
-    if (worst < 0) break;
-    active[worst] = true;
-  }
+  PointVector vn(n), goal(n);
+  for (int i = 0; i < n; ++i) vn(i) = k.point_velocity(set.r[i]).y(), goal(i) = target[i];
+  const PointVector impulse = solve_active_set(system, vn, goal);
   Impulses applied{};
   for (int i = 0; i < n; ++i) {
     if (impulse(i) <= 0.0) continue;
-    k.apply(s, set.r[i], impulse(i) * up);
+    k.apply(s, set.r[i], impulse(i) * Vec3::UnitY());
     applied[i] = impulse(i);
   }
   return applied;
@@ -195,7 +118,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   const BodyState s0 = s;
   const Kinematics k0 = kinematics_of(s, c);
   Kinematics k = k0;
-  NormalSystem system(k0, set);
+  ActiveSetCache system(normal_matrix(k0, set));
   Impulses normal = solve_normal(s, k, set, system, target);
   if (mu <= 0.0) return set.count;
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
