@@ -262,7 +262,8 @@ const std::vector<Case>& cases() {
       {"AbsoluteFormTarget", RAW("GET /etc/passwd HTTP/1.1\r\nHost: x\r\n\r\n"), 404, ""},
       {"SymlinkOut", GET("/leak.txt"), 403, ""},
       {"SymlinkDirOut", GET("/up/secret.txt"), 403, ""},
-      {"NulInPath", GET("/index.html%00.js"), 400, ""},
+      {"NulInPath", GET("/index.html%00.js"), 403, ""},
+      {"BadPercentEscape", GET("/%zz"), 400, ""},
       {"NoDirectoryListing", GET("/empty/"), 404, ""},
       // ---- WebSocket ---------------------------------------------------------------------
       {"WsWrongOrigin",
