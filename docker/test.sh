@@ -70,13 +70,15 @@ fi
 # ---- private Docker engine ------------------------------------------------------------------
 # Not under /tmp if that is a tmpfs or overlay: overlay2 needs a real file system below it.
 WORK=$(mktemp -d /var/tmp/tumble-docker.XXXXXX)
+# Beside compose.yaml, so its relative build context still resolves (git-ignored).
+HOSTNET_COMPOSE=docker/.compose.hostnet.yaml
 export DOCKER_HOST=unix://$WORK/docker.sock
 DOCKERD_PID=""
 cleanup() {
   local rc=$?
   set +e
   if [ -n "$DOCKERD_PID" ] && kill -0 "$DOCKERD_PID" 2>/dev/null; then
-    "${COMPOSE[@]}" -p "$PROJECT" -f docker/compose.yaml -f docker/compose.test.yaml \
+    "${COMPOSE[@]}" -p "$PROJECT" -f "$HOSTNET_COMPOSE" -f docker/compose.test.yaml \
       down --timeout 2 >/dev/null 2>&1
     kill -TERM "$DOCKERD_PID" 2>/dev/null
     for _ in $(seq 1 150); do kill -0 "$DOCKERD_PID" 2>/dev/null || break; sleep 0.1; done
@@ -206,7 +208,24 @@ grep -E 'tests passed|tests failed' "$WORK/build.log" | tail -n 1 | sed 's/^#[0-
 # ---- up, healthy, probe -------------------------------------------------------------------------
 TUMBLE_TEST_PORT=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 export TUMBLE_TEST_PORT
-compose() { "${COMPOSE[@]}" -p "$PROJECT" -f docker/compose.yaml -f docker/compose.test.yaml "$@"; }
+# Host networking cannot publish ports, and Compose v1 merges (cannot drop) the base file's
+# `ports:` list, so the test runs docker/compose.yaml with that one block removed; everything
+# else (image, environment, read-only root, tmpfs, capabilities, healthcheck) is as shipped.
+"${COMPOSE[@]}" -f docker/compose.yaml config -q || fail "compose config (docker/compose.yaml)"
+python3 - docker/compose.yaml "$HOSTNET_COMPOSE" <<'PY' || fail "deriving the host-network compose file"
+import sys
+lines, out, skip = open(sys.argv[1]).read().splitlines(), [], False
+for line in lines:
+    if line.strip() == "ports:":
+        skip = True
+        continue
+    if skip and line.lstrip().startswith("- "):
+        continue
+    skip = False
+    out.append(line)
+open(sys.argv[2], "w").write("\n".join(out) + "\n")
+PY
+compose() { "${COMPOSE[@]}" -p "$PROJECT" -f "$HOSTNET_COMPOSE" -f docker/compose.test.yaml "$@"; }
 compose config -q || fail "compose config"
 T=$(now)
 log "compose up (host network, port $TUMBLE_TEST_PORT)"
