@@ -1,5 +1,5 @@
 #pragma once
-/// The five questions tumble-bench answers; each writes CSV, plots and its docs section into
+/// The six questions tumble-bench answers; each writes CSV, plots and its docs section into
 /// Options::out. Single-threaded.
 #include "common.hpp"
 
@@ -16,5 +16,7 @@ void run_throughput(const Options& o);
 void run_skip(const Options& o);
 /// The same scenes on Bullet, ODE and MuJoCo, interleaved with Tumble; ratios.
 void run_peers(const Options& o);
+/// Box–box contact and stacking (tower, pyramid, pile) on Tumble and the peers, interleaved.
+void run_contact(const Options& o);
 
 }  // namespace tumble_bench

@@ -2,6 +2,8 @@
 /// substep per step, implicit body-frame gyroscopic term, restitution as Bullet multiplies it.
 #include <btBulletDynamicsCommon.h>
 
+#include <cmath>
+
 #include "peers/peer.hpp"
 
 namespace tumble_bench {
@@ -17,9 +19,10 @@ class BulletWorld final : public PeerWorld {
     if (scene.floor) {
       floor_shape_ = std::make_unique<btStaticPlaneShape>(btVector3(0, 1, 0), 0);
       btRigidBody::btRigidBodyConstructionInfo info(0, nullptr, floor_shape_.get());
-      // Bullet combines restitution and friction as products of the two bodies' values.
-      info.m_restitution = 1.0;
-      info.m_friction = 1.0;
+      // Bullet combines restitution and friction as products of the two bodies' values: with
+      // √e and √μ on every body and on the plane, box–plane and box–box pairs both get e, μ.
+      info.m_restitution = std::sqrt(scene.restitution);
+      info.m_friction = std::sqrt(scene.friction);
       floor_ = std::make_unique<btRigidBody>(info);
       world_.addRigidBody(floor_.get());
     }
@@ -35,8 +38,8 @@ class BulletWorld final : public PeerWorld {
       btRigidBody::btRigidBodyConstructionInfo info(b.mass, nullptr, shapes_.back().get(),
                                                      inertia);
       info.m_startWorldTransform = t;
-      info.m_restitution = scene.restitution;
-      info.m_friction = scene.friction;
+      info.m_restitution = std::sqrt(scene.restitution);
+      info.m_friction = std::sqrt(scene.friction);
       auto body = std::make_unique<btRigidBody>(info);
       body->setLinearVelocity(to_bt(b.velocity));
       body->setAngularVelocity(to_bt(b.angular_velocity));
@@ -90,9 +93,11 @@ PeerEngine bullet_peer() {
   return {"bullet", std::to_string(btGetVersion() / 100) + "." + std::to_string(btGetVersion() % 100),
           "btDiscreteDynamicsWorld + btDbvtBroadphase + sequential-impulse solver (10 iterations, "
           "default), double precision; stepSimulation(dt, 1, dt) (one fixed substep); "
-          "BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY; restitution e on the box and 1 on the "
-          "plane (Bullet multiplies them), friction likewise; default deactivation (sleeping) "
-          "and default 0.04 m collision margin",
+          "BT_ENABLE_GYROSCOPIC_FORCE_IMPLICIT_BODY; restitution √e on every box and on the "
+          "plane (Bullet multiplies the two values of a pair, so box–plane and box–box pairs "
+          "both get e), friction √μ likewise; default deactivation (sleeping after 2 s below "
+          "0.8 m/s and 1 rad/s; DISABLE_DEACTIVATION when a run must stay awake) and default "
+          "0.04 m collision margin",
           [](const PeerScene& s) { return std::make_unique<BulletWorld>(s); }};
 }
 

@@ -38,11 +38,58 @@ double contact_time_constant(double dt, double zeta) {
   return std::max(0.02, 2.0 * dt / std::max(zeta, 0.05));  // e → 1 makes ζ → 0
 }
 
-/// A box on a plane makes at most 4 contacts; MuJoCo 2.2 sizes mjData from these at load.
-std::size_t contact_capacity(std::size_t bodies) { return 4 * bodies + 16; }
-/// Constraint rows: 1 per frictionless contact, 4 per pyramidal condim-3 contact.
-std::size_t constraint_rows(std::size_t bodies, int condim) {
-  return contact_capacity(bodies) * (condim == 1 ? 1 : 4);
+/// Rows of the constraint Jacobian per contact: 1 frictionless, 4 for a pyramidal condim-3 cone.
+std::size_t rows_per_contact(int condim) { return condim == 1 ? 1 : 4; }
+
+/// Bytes MuJoCo 2.2 allocates up front in mjData per constraint row for a model of nv dofs:
+/// efc_J, efc_JT (mjtNum) and their column indices (int), nv each; efc_AR (mjtNum) and
+/// efc_AR_colind (int), njmax each; about 20 short per-row arrays.
+double bytes_for_rows(double rows, double nv) { return rows * (24.0 * nv + 12.0 * rows + 160.0); }
+
+/// mjData's buffer size is an `int` in MuJoCo 2.2 (mjData::nbuffer): nothing beyond 2 GiB can
+/// be allocated, whatever memory the machine has. We stay at 1.6e9 bytes for the constraint
+/// arrays, leaving room for the contact array, the stack and the rest of mjData.
+constexpr double kMaxConstraintBytes = 1.6e9;
+
+/// nconmax / njmax for a scene, or a reason why it does not fit.
+struct Capacity {
+  std::size_t contacts = 0;  ///< nconmax.
+  std::size_t rows = 0;      ///< njmax.
+  std::string refused;       ///< Non-empty: the scene cannot run.
+};
+
+Capacity capacity_for(const PeerScene& scene) {
+  const std::size_t n = scene.boxes.size();
+  const int condim = scene.friction <= 0.0 ? 1 : 3;
+  const std::size_t per = rows_per_contact(condim);
+  const double nv = 6.0 * static_cast<double>(n);
+  // Separated scenes: a box on the plane makes at most 4 contacts. Stacks and piles: a box
+  // pair makes up to 8 (mjc_BoxBox), and a box in a pile touches several others, so we ask for
+  // 24 contacts per box and take what MuJoCo 2.2's allocation allows.
+  const std::size_t wanted = (scene.stacking ? 24 : 4) * n + 16;
+  const std::size_t needed = 4 * n + 16;  // every box resting on 4 points
+  Capacity c;
+  c.contacts = wanted;
+  while (c.contacts > needed &&
+         bytes_for_rows(static_cast<double>(c.contacts * per), nv) > kMaxConstraintBytes)
+    c.contacts = std::max(needed, c.contacts * 9 / 10);
+  c.rows = c.contacts * per;
+  const double bytes = bytes_for_rows(static_cast<double>(c.rows), nv);
+  if (bytes > kMaxConstraintBytes) {
+    char buf[700];
+    std::snprintf(buf, sizeof buf,
+                  "MuJoCo 2.2 allocates its constraint arrays densely and up front in mjData "
+                  "(efc_AR and its column indices, njmax × njmax; efc_J/efc_JT, njmax × nv), and "
+                  "mjData's buffer size is a C int (≤ 2 GiB); %zu boxes resting on 4 contact "
+                  "points each need nconmax ≥ %zu, njmax ≥ %zu rows with nv = %.0f, i.e. %.1f GB "
+                  "of constraint arrays, beyond what the int buffer can hold; a smaller "
+                  "<size nconmax/njmax> would drop contacts once the boxes land "
+                  "(mjWARN_CONTACTFULL / mjWARN_CNSTRFULL), so it would not be the same "
+                  "simulation; MuJoCo 2.3 replaced these arrays with an arena (<size memory>)",
+                  n, needed, needed * per, nv, bytes / 1e9);
+    c.refused = buf;
+  }
+  return c;
 }
 
 std::string mjcf(const PeerScene& scene, bool rk4) {
@@ -58,8 +105,8 @@ std::string mjcf(const PeerScene& scene, bool rk4) {
     << "  <option timestep=\"" << scene.dt << "\" gravity=\"" << scene.gravity.x() << ' '
     << scene.gravity.y() << ' ' << scene.gravity.z() << "\" integrator=\""
     << (rk4 ? "RK4" : "Euler") << "\"/>\n"
-    << "  <size nconmax=\"" << contact_capacity(n) << "\" njmax=\""
-    << constraint_rows(n, condim) << "\"/>\n"
+    << "  <size nconmax=\"" << capacity_for(scene).contacts << "\" njmax=\""
+    << capacity_for(scene).rows << "\"/>\n"
     << "  <default><geom condim=\"" << condim << "\" friction=\"" << mu
     << " 0.005 0.0001\" solref=\"" << contact_time_constant(scene.dt, zeta) << ' ' << zeta
     << "\"/></default>\n"
@@ -77,39 +124,12 @@ std::string mjcf(const PeerScene& scene, bool rk4) {
   return x.str();
 }
 
-/// MuJoCo 2.2 allocates efc_J (njmax × nv) and efc_AR (njmax × njmax) densely.
-double mujoco_dense_bytes(const PeerScene& scene) {
-  const double n = static_cast<double>(scene.boxes.size());
-  const double rows = static_cast<double>(
-      constraint_rows(scene.boxes.size(), scene.friction <= 0.0 ? 1 : 3));
-  return rows * 6.0 * n * 8.0 + rows * rows * 12.0;
-}
-
-/// Above this we refuse rather than take the shared machine's memory.
-constexpr double kMaxGigabytes = 3.0;
-
 class MujocoWorld final : public PeerWorld {
  public:
   MujocoWorld(const PeerScene& scene, bool rk4) {
-    const double gb = mujoco_dense_bytes(scene) / 1e9;
-    if (gb > kMaxGigabytes) {
-      // <size njmax> cannot be lowered to fit: once the boxes land, every one of them holds
-      // up to 4 floor contacts, and rows beyond njmax do not fit (MuJoCo warns
-      // mjWARN_CNSTRFULL and drops constraints), so it would no longer be the same
-      // simulation. The arena that removes this limit (<size memory>) arrived in MuJoCo 2.3.
-      char buf[600];
-      std::snprintf(buf, sizeof buf,
-                    "MuJoCo 2.2 allocates efc_J (njmax × nv) and efc_AR (njmax × njmax) densely "
-                    "in mjData; the scene needs njmax ≥ %zu constraint rows (up to 4 floor "
-                    "contacts per box on the floor) with nv = %zu, i.e. %.0f GB, so it was not built "
-                    "(limit %.0f GB on this shared machine); a smaller njmax in <size> is no way "
-                    "out: the rows of the landed boxes would not fit (MuJoCo warns "
-                    "mjWARN_CNSTRFULL and drops constraints), so it would not be the same "
-                    "simulation; MuJoCo 2.3 replaced these arrays with an arena (<size memory>)",
-                    constraint_rows(scene.boxes.size(), scene.friction <= 0.0 ? 1 : 3),
-                    6 * scene.boxes.size(), gb, kMaxGigabytes);
-      throw std::runtime_error(buf);
-    }
+    const Capacity cap = capacity_for(scene);
+    if (!cap.refused.empty()) throw std::runtime_error(cap.refused);
+    nconmax_ = cap.contacts;
     static std::atomic<int> counter{0};
     const std::filesystem::path path =
         std::filesystem::temp_directory_path() /
@@ -155,9 +175,19 @@ class MujocoWorld final : public PeerWorld {
 
   long awake_count() const override { return static_cast<long>(model_->nbody - 1); }
 
+  std::string trouble() const override {
+    const int contacts = data_->warning[mjWARN_CONTACTFULL].number;
+    const int rows = data_->warning[mjWARN_CNSTRFULL].number;
+    if (contacts == 0 && rows == 0) return {};
+    return "contact buffer full in " + std::to_string(contacts) + " steps, constraint buffer " +
+           "full in " + std::to_string(rows) + " steps (nconmax " + std::to_string(nconmax_) +
+           "): contacts were dropped";
+  }
+
  private:
   mjModel* model_ = nullptr;
   mjData* data_ = nullptr;
+  std::size_t nconmax_ = 0;
 };
 
 }  // namespace
@@ -170,7 +200,10 @@ PeerEngine mujoco_peer(bool rk4) {
               "plane turned to +y; soft contacts, solref = (0.02 s, ζ) with ζ from e through "
               "e = exp(−ζπ/√(1−ζ²)) (MuJoCo has no restitution coefficient), condim 1 when "
               "frictionless else 3 with μ; Coriolis and centrifugal terms always included; "
-              "MuJoCo 2.2 has no sleeping",
+              "MuJoCo 2.2 has no sleeping; <size nconmax njmax> 4 contacts per box + 16 for "
+              "separated scenes; for stacks and piles 24 contacts per box + 16, lowered until "
+              "the up-front constraint arrays fit mjData's int-sized buffer (≤ 1.6 GB for "
+              "them), and the contact and constraint overflow warnings checked after the run",
           [rk4](const PeerScene& s) { return std::make_unique<MujocoWorld>(s, rk4); }};
 }
 

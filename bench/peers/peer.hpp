@@ -33,6 +33,9 @@ struct PeerScene {
   double friction = 0.0;          ///< Coulomb μ against the floor.
   double dt = 1.0 / 240.0;        ///< Step, s.
   bool allow_sleep = true;        ///< Let the peer deactivate still bodies (its default).
+  /// Bodies rest on each other (stacks, piles): peers add their documented stacking settings
+  /// and room for body–body contacts. Separated scenes leave it false.
+  bool stacking = false;
   std::vector<PeerBox> boxes;     ///< Bodies.
 };
 
@@ -54,6 +57,9 @@ class PeerWorld {
   virtual PeerBodyState state(std::size_t i) const = 0;
   /// Bodies the peer currently simulates (not deactivated), or -1 if it cannot say.
   virtual long awake_count() const { return -1; }
+  /// What went wrong so far in a way that changes the simulation (a full contact buffer …),
+  /// empty when nothing did.
+  virtual std::string trouble() const { return {}; }
 };
 
 /// A peer engine: its name, what we set, and a factory.
