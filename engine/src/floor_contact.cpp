@@ -17,7 +17,7 @@ constexpr int kMaxImpactsPerStep = 32;
 constexpr double kSlop = 1e-12;          // m: deeper than this below the floor is penetration.
 constexpr double kSimultaneous = 1e-9;   // m: vertices this close to the lowest hit together.
 constexpr double kContactBand = 1e-6;    // m: vertices this close to the floor are touching.
-constexpr int kMaxPoints = 8;
+constexpr int kMaxPoints = kMaxActiveSetPoints;  // a box has 8 vertices
 
 
 /// Body-frame offsets and world velocities of the vertices touching the floor.
