@@ -2,18 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <string>
 #include <vector>
 
+#include "child_process.hpp"
 #include "test_client.hpp"
-
-extern char** environ;
 
 namespace tumble::server::test {
 namespace {
@@ -21,50 +16,12 @@ namespace {
 using namespace std::chrono_literals;
 
 // A child tumble-server with its stdout and stderr on a pipe.
-struct Child {
-  pid_t pid = -1;
-  FILE* out = nullptr;
-
-  explicit Child(std::vector<std::string> args) {
+struct Child : ChildProcess {
+  explicit Child(std::vector<std::string> args) : ChildProcess(with_binary(std::move(args))) {}
+  static std::vector<std::string> with_binary(std::vector<std::string> args) {
     args.insert(args.begin(), TUMBLE_SERVER_BINARY);
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    int fds[2];
-    if (pipe(fds) != 0) return;
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
-    posix_spawn_file_actions_addclose(&actions, fds[0]);
-    posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    close(fds[1]);
-    out = fdopen(fds[0], "r");
+    return args;
   }
-  ~Child() {
-    if (pid > 0 && !exited) {
-      kill(pid, SIGKILL);
-      waitpid(pid, nullptr, 0);
-    }
-    if (out) fclose(out);
-  }
-  std::string line() {
-    char buf[4096];
-    return out && fgets(buf, sizeof buf, out) ? std::string(buf) : std::string();
-  }
-  std::string rest() {
-    std::string all;
-    for (std::string l = line(); !l.empty(); l = line()) all += l;
-    return all;
-  }
-  int wait() {
-    int status = 0;
-    waitpid(pid, &status, 0);
-    exited = true;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  }
-  bool exited = false;
 };
 
 std::uint16_t port_from(const std::string& url_line) {
@@ -81,7 +38,7 @@ TEST(Main, PrintsTheUrlAndStopsCleanlyOnSigterm) {
   WsClient viewer(port);
   ASSERT_TRUE(viewer.read());
   const auto t0 = std::chrono::steady_clock::now();
-  kill(server.pid, SIGTERM);
+  server.signal(SIGTERM);
   bool closed = false;
   for (int i = 0; i < 200 && !closed; ++i) closed = !viewer.read(1s);
   EXPECT_EQ(viewer.last_error(), boost::beast::websocket::error::closed);
@@ -92,7 +49,7 @@ TEST(Main, PrintsTheUrlAndStopsCleanlyOnSigterm) {
 TEST(Main, SigintAlsoExitsWithZero) {
   Child server({"--port", "0"});
   ASSERT_FALSE(server.line().empty());
-  kill(server.pid, SIGINT);
+  server.signal(SIGINT);
   EXPECT_EQ(server.wait(), 0);
 }
 
