@@ -9,9 +9,9 @@
 ///   sim.submit({PauseCommand{}, [](CommandResult r) { … }});
 ///   auto snap = sim.latest();   // any thread
 ///   sim.stop();
-#include <atomic>
 #include <deque>
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <utility>
 
@@ -21,6 +21,29 @@
 #include "tumble/world.hpp"
 
 namespace tumble::server {
+
+/// The latest snapshot, handed from the simulation thread (store) to any thread (load).
+/// A mutex held for one shared_ptr copy, not std::atomic<std::shared_ptr>: GCC 12's
+/// atomic load releases its internal lock with memory_order_relaxed, so a later store is
+/// not ordered after the read — a data race in the C++ memory model, reported by TSan.
+class SnapshotSlot {
+ public:
+  /// The stored snapshot (null before the first store). Thread-safe.
+  std::shared_ptr<const Snapshot> load() const {
+    std::lock_guard lock(mutex_);
+    return value_;
+  }
+  /// Replaces the snapshot; the old one is released outside the lock. Thread-safe.
+  void store(std::shared_ptr<const Snapshot> snapshot) {
+    std::unique_lock lock(mutex_);
+    std::shared_ptr<const Snapshot> old = std::exchange(value_, std::move(snapshot));
+    lock.unlock();
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  std::shared_ptr<const Snapshot> value_;
+};
 
 /// The real-time loop around one World. Public members are thread-safe.
 class SimLoop {
@@ -80,7 +103,7 @@ class SimLoop {
   std::deque<std::pair<Clock::time_point, double>> rtf_samples_;  // (wall, sim time)
   double real_time_factor_ = 1.0;
   CommandQueue queue_;
-  std::atomic<std::shared_ptr<const Snapshot>> latest_;
+  SnapshotSlot latest_;
   std::thread thread_;
 };
 
