@@ -1,6 +1,12 @@
 // The WebSocket stream (/ws) against a real server: scene messages, frame cadence and content.
 #include <gtest/gtest.h>
 
+#include <iostream>
+#include <string>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/write.hpp>
+
 #include "frame.hpp"
 #include "server_fixture.hpp"
 #include "tumble/world.hpp"
@@ -229,6 +235,61 @@ TEST_F(WsSessionTest, NoViewerNoFrames) {
   WsClient c(port_);
   const DecodedFrame f = next_frame(c);
   EXPECT_LE(f.frame_number, last + 3) << "frames were encoded while nobody watched";
+}
+
+// A viewer that completes the handshake and then never reads. The server keeps at most one
+// frame pending for it (the newest; each one it replaces counts as dropped), so it costs one
+// frame buffer, not a queue, and a reading viewer beside it still gets its frames.
+class WsSessionStalled : public WsSessionTest {
+  // 1000 boxes in free flight (no gravity, no floor): ~97 KB frames, so the kernel's buffers
+  // of the stalled connection (a few MB on loopback) are full within the first second.
+  Scene initial_scene() override {
+    Scene s;
+    s.world.name = "stalled";
+    s.world.gravity = Vec3::Zero();
+    s.world.floor.reset();
+    for (int i = 0; i < 1000; ++i) {
+      BodyDef b;
+      b.name = "b" + std::to_string(i);
+      b.position = Vec3(3.0 * (i % 10), 3.0 * (i / 10 % 10), 3.0 * (i / 100));
+      b.angular_velocity = Vec3(0.3, 0.2, 0.1);
+      s.bodies.push_back(b);
+    }
+    return s;
+  }
+};
+
+TEST_F(WsSessionStalled, ANonReadingViewerIsKeptAtOnePendingFrame) {
+  namespace net = boost::asio;
+  WsClient reader(port_);
+  net::io_context ioc;
+  net::ip::tcp::socket stalled(ioc);
+  stalled.open(net::ip::tcp::v4());
+  stalled.set_option(net::socket_base::receive_buffer_size(4096));
+  stalled.connect({net::ip::make_address("127.0.0.1"), port_});
+  net::write(stalled, net::buffer(std::string(
+                          "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
+                          "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                          "Sec-WebSocket-Version: 13\r\n\r\n")));
+  // 4 s = 200 frames ≈ 19 MB for the stalled viewer: far more than its socket can hold.
+  const std::uint64_t dropped_before = server_->metrics().frames_dropped();
+  std::uint32_t first = 0, last = 0;
+  int received = 0;
+  for (const auto until = std::chrono::steady_clock::now() + 4s;
+       std::chrono::steady_clock::now() < until;) {
+    const DecodedFrame f = next_frame(reader);
+    if (received++ == 0) first = f.frame_number;
+    last = f.frame_number;
+  }
+  const std::uint64_t dropped = server_->metrics().frames_dropped() - dropped_before;
+  std::cout << "[ measured ] 4 s with a stalled viewer: " << dropped << " frames replaced, reader got "
+            << received << " of " << (last - first + 1) << " frames\n";
+  EXPECT_EQ(server_->viewers(), 2u);
+  EXPECT_GT(dropped, 50u) << "the stalled viewer's frames were queued, not replaced";
+  EXPECT_LT(dropped, 200u);
+  EXPECT_GE(received, 0.9 * (last - first + 1)) << "the reading viewer lost frames";
+  EXPECT_GE(last - first + 1, 150u) << "the broadcast slowed down";
+  stalled.close();
 }
 
 class WsSessionLimited : public WsSessionTest {
