@@ -41,8 +41,12 @@ run_preset() {
   stamp "${preset}: configure, build $*"
   cmake --preset "${preset}" -DTUMBLE_NODE=TUMBLE_NODE-NOTFOUND >/dev/null
   ninja -C "build/${preset}" -j"${JOBS}" "$@"
-  stamp "${preset}: ctest"
-  ctest --preset "${preset}" -j1 -E "${EXCLUDE}"
+  # Engine tests are pure computation: both cores. Server tests measure real-time behaviour
+  # (frame cadence, real-time factor): one at a time.
+  stamp "${preset}: ctest, engine suite"
+  ctest --preset "${preset}" -j"${JOBS}" -L engine -E "${EXCLUDE}"
+  stamp "${preset}: ctest, server suite"
+  ctest --preset "${preset}" -j1 -L server -E "${EXCLUDE}"
 }
 
 run_preset asan engine_tests server_tests tumble-server scene_fuzz rest_fuzz frame_fuzz
