@@ -35,10 +35,11 @@ class SnapshotSlot {
   }
   /// Replaces the snapshot; the old one is released outside the lock. Thread-safe.
   void store(std::shared_ptr<const Snapshot> snapshot) {
-    std::unique_lock lock(mutex_);
-    std::shared_ptr<const Snapshot> old = std::exchange(value_, std::move(snapshot));
-    lock.unlock();
-  }
+    {
+      std::lock_guard lock(mutex_);
+      value_.swap(snapshot);
+    }
+  }  // `snapshot` now holds the old one: freed here, after the unlock.
 
  private:
   mutable std::mutex mutex_;

@@ -226,14 +226,7 @@ int main(int argc, char** argv) {
     viewers.back()->start();
   }
   // The stalled viewer: completes the upgrade, then never reads (tiny receive buffer).
-  tcp::socket stalled(ioc);
-  stalled.open(tcp::v4());
-  stalled.set_option(net::socket_base::receive_buffer_size(4096));
-  stalled.connect(local(port));
-  net::write(stalled, net::buffer(std::string(
-                          "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
-                          "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-                          "Sec-WebSocket-Version: 13\r\n\r\n")));
+  tcp::socket stalled = stalled_viewer(ioc, port);
 
   const auto t_start = Clock::now() + std::chrono::seconds(2);  // warm-up: connects settle
   const auto t_end = t_start + std::chrono::duration_cast<Clock::duration>(

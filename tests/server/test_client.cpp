@@ -72,6 +72,19 @@ HttpReply http_request(std::uint16_t port, http::verb verb, std::string target, 
   });
 }
 
+boost::asio::ip::tcp::socket stalled_viewer(boost::asio::io_context& ioc, std::uint16_t port) {
+  namespace net = boost::asio;
+  net::ip::tcp::socket socket(ioc);
+  socket.open(net::ip::tcp::v4());
+  socket.set_option(net::socket_base::receive_buffer_size(4096));
+  socket.connect({net::ip::make_address("127.0.0.1"), port});
+  net::write(socket, net::buffer(std::string(
+                         "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
+                         "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                         "Sec-WebSocket-Version: 13\r\n\r\n")));
+  return socket;
+}
+
 HttpReply raw_request(std::uint16_t port, const std::string& raw) {
   auto data = std::make_shared<std::string>(raw);
   return exchange(port, raw.starts_with("HEAD "), [data](beast::tcp_stream& s, std::function<void(beast::error_code)> done) {

@@ -8,6 +8,7 @@
 #include <string>
 
 #include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
@@ -43,6 +44,10 @@ inline HttpReply http_post(std::uint16_t port, std::string target, std::string b
 
 /// Writes `raw` bytes as they are and reads one HTTP response (5 s timeout).
 HttpReply raw_request(std::uint16_t port, const std::string& raw);
+
+/// A viewer that sends the WebSocket upgrade to /ws and then never reads (4 KiB receive
+/// buffer): the slow client of the load test and of WsSessionStalled. Blocking connect.
+boost::asio::ip::tcp::socket stalled_viewer(boost::asio::io_context& ioc, std::uint16_t port);
 
 /// A WebSocket viewer connected to /ws.
 class WsClient {

@@ -4,9 +4,6 @@
 #include <iostream>
 #include <string>
 
-#include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/write.hpp>
-
 #include "frame.hpp"
 #include "server_fixture.hpp"
 #include "tumble/world.hpp"
@@ -260,17 +257,9 @@ class WsSessionStalled : public WsSessionTest {
 };
 
 TEST_F(WsSessionStalled, ANonReadingViewerIsKeptAtOnePendingFrame) {
-  namespace net = boost::asio;
   WsClient reader(port_);
-  net::io_context ioc;
-  net::ip::tcp::socket stalled(ioc);
-  stalled.open(net::ip::tcp::v4());
-  stalled.set_option(net::socket_base::receive_buffer_size(4096));
-  stalled.connect({net::ip::make_address("127.0.0.1"), port_});
-  net::write(stalled, net::buffer(std::string(
-                          "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\n"
-                          "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-                          "Sec-WebSocket-Version: 13\r\n\r\n")));
+  boost::asio::io_context ioc;
+  boost::asio::ip::tcp::socket stalled = stalled_viewer(ioc, port_);
   // 4 s = 200 frames ≈ 19 MB for the stalled viewer: far more than its socket can hold.
   const std::uint64_t dropped_before = server_->metrics().frames_dropped();
   std::uint32_t first = 0, last = 0;
