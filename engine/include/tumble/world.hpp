@@ -16,24 +16,12 @@
 
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
+#include "tumble/step_stats.hpp"
 
 namespace tumble {
 
 /// Index of a body in its World (its position in the scene's list).
 using BodyId = std::uint32_t;
-
-/// What the last step did (cheap counters, for benchmarks and metrics).
-struct StepStats {
-  std::uint32_t impacts = 0;         ///< Floor impacts resolved.
-  std::uint32_t toi_iterations = 0;  ///< Trajectory evaluations spent finding impacts.
-  std::uint32_t awake = 0;           ///< Bodies integrated.
-  std::uint32_t newly_frozen = 0;    ///< Bodies that went non-finite this step.
-  std::uint32_t pairs = 0;           ///< Broad-phase pairs whose bounding boxes overlap.
-  std::uint32_t contacts = 0;        ///< Body–body contacts (pairs with manifold points).
-  std::uint32_t contact_points = 0;  ///< Points in those contacts.
-  std::uint32_t islands = 0;         ///< Islands of touching bodies solved together.
-  std::uint32_t solver_bodies = 0;   ///< Bodies stepped by the contact solver.
-};
 
 /// Body–body contact data kept between steps (engine/src/contact_stage.hpp).
 struct ContactState;
