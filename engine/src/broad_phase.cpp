@@ -1,5 +1,9 @@
 #include "broad_phase.hpp"
 
+#include <cmath>
+
+#include "pipeline.hpp"
+
 #include <algorithm>
 
 namespace tumble {
@@ -141,6 +145,82 @@ void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
       if (overlap(ba, boxes[*it])) add_pair(pairs, a, *it);
   }
   std::sort(pairs.begin(), pairs.end());
+}
+
+}  // namespace tumble
+
+namespace tumble {
+namespace {
+
+bool contains(const Aabb& outer, const Aabb& inner) {
+  return (outer.lo.array() <= inner.lo.array()).all() &&
+         (inner.hi.array() <= outer.hi.array()).all();
+}
+
+bool overlaps(const Aabb& a, const Aabb& b) {
+  return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
+}
+
+/// Each body's swept box and flags. A sleeping body does not move: its box (and candidacy)
+/// is computed once, when it is first seen asleep, so 10,000 sleeping boxes cost a flag test
+/// each per step.
+void update_boxes(StepContext& ctx) {
+  BroadPhaseCache& k = ctx.broad;
+  StepScratch& s = ctx.scratch;
+  const std::size_t n = ctx.bodies.size();
+  k.boxes.resize(n);
+  k.box_cached.resize(n, 0);
+  s.active.resize(n);
+  s.candidate.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Body& b = ctx.bodies[i];
+    s.active[i] = b.activity == Activity::awake;
+    if (!s.active[i] && k.box_cached[i]) continue;
+    k.boxes[i] = swept_aabb(b.s, b.c, ctx.world.gravity, s.active[i] ? ctx.dt : 0.0,
+                            0.5 * kSpeculativeDistance);
+    k.box_cached[i] = !s.active[i];
+    // A body about to go non-finite (an overflowing impulse) touches nothing: it flies alone
+    // and finalize freezes it.
+    s.candidate[i] = b.activity != Activity::frozen &&
+                     std::isfinite(k.boxes[i].lo.sum() + k.boxes[i].hi.sum());
+  }
+}
+
+}  // namespace
+
+// Pairs from fattened boxes, reused while every awake body stays inside its fat box and no
+// body changes activity (Box2D's fat AABBs, Catto 2019 "Dynamic bounding volume
+// hierarchies"): a falling box moves a few centimetres a step, so the sweep runs about once
+// every ten steps and the steps between only filter the cached pairs by the tight boxes.
+void broad_phase(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  s.pairs.clear();
+  const std::size_t n = ctx.bodies.size();
+  if (n < 2 || std::none_of(ctx.bodies.begin(), ctx.bodies.end(),
+                            [](const Body& b) { return b.activity == Activity::awake; }))
+    return;
+  update_boxes(ctx);
+  BroadPhaseCache& k = ctx.broad;
+  bool rebuild = k.fat.size() != n;
+  std::uint64_t signature = 1469598103934665603ull;
+  for (std::size_t i = 0; i < n && !rebuild; ++i) {
+    signature = (signature ^ (s.active[i] | (s.candidate[i] << 1))) * 1099511628211ull;
+    if (s.active[i] && !contains(k.fat[i], k.boxes[i])) rebuild = true;
+  }
+  if (rebuild || signature != k.fat_signature) {
+    k.fat.resize(n);
+    signature = 1469598103934665603ull;
+    for (std::size_t i = 0; i < n; ++i) {
+      signature = (signature ^ (s.active[i] | (s.candidate[i] << 1))) * 1099511628211ull;
+      const double margin = s.active[i] ? 0.5 * ctx.bodies[i].c.bounding_radius : 0.0;
+      k.fat[i] = {k.boxes[i].lo.array() - margin, k.boxes[i].hi.array() + margin};
+    }
+    k.fat_signature = signature;
+    find_pairs(k.fat, s.active, s.candidate, k.sweep, k.fat_pairs);
+  }
+  for (const BodyPair& p : k.fat_pairs)
+    if (overlaps(k.boxes[p.first], k.boxes[p.second])) s.pairs.push_back(p);
+  ctx.stats.pairs = static_cast<std::uint32_t>(s.pairs.size());
 }
 
 }  // namespace tumble

@@ -13,16 +13,6 @@ namespace {
 
 static_assert(kMaxContactPoints <= kMaxActiveSetPoints);
 
-/// Velocities of a body during the solve (I⁻¹ fixed at the start of the step).
-struct SolverBody {
-  Vec3 v = Vec3::Zero();   // m/s
-  Vec3 w = Vec3::Zero();   // rad/s
-  Vec3 vp = Vec3::Zero();  // split-impulse pseudo velocity, m/s
-  Vec3 wp = Vec3::Zero();  // rad/s
-  Mat3 inv_inertia = Mat3::Zero();
-  double inv_mass = 0.0;
-};
-
 /// Two unit tangents completing n to a right-handed basis, chosen the same way every step so
 /// accumulated friction impulses stay meaningful for warm starting.
 void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
@@ -33,14 +23,15 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
 
 class Solver {
  public:
-  Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids,
-         std::vector<std::int32_t>& index)
-      : bodies_(bodies), ids_(ids), index_(index) {
-    index_.assign(bodies.size(), -1);
+  Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch)
+      : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
+        block_(scratch.blocks), order_(scratch.order) {
+    index_.resize(bodies.size(), -1);
     sb_.resize(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Body& b = bodies[ids[k]];
       index_[ids[k]] = static_cast<std::int32_t>(k);
+      sb_[k] = SolverBody{};
       sb_[k].inv_mass = b.c.inv_mass;
       sb_[k].inv_inertia = inverse_inertia_world(b.s, b.c);
       sb_[k].v = b.s.P * b.c.inv_mass;
@@ -121,7 +112,10 @@ class Solver {
   void warm_start(Contact& c);
   void solve_velocity(Contact& c, std::size_t n, double dt);
   void solve_position(Contact& c, const SolverSettings& s, double dt);
-  void finish(double dt);
+  /// Writes the end-of-step momenta P = m v, L = I w (I at the step start).
+  void finish();
+  /// Forgets the body index, so the next step starts from an index of −1 only.
+  void release();
   /// Normal velocity a point must reach: a speculative point may close its gap within the
   /// step, a touching one may not approach (its penetration is the split impulse's job).
   static double target_of(const ContactPoint& p, double dt) {
@@ -132,8 +126,9 @@ class Solver {
   std::span<Body> bodies_;
   std::span<const std::uint32_t> ids_;
   std::vector<std::int32_t>& index_;
-  std::vector<SolverBody> sb_;
-  std::vector<PointMatrix> block_;  // pseudo-inverse of each contact's normal matrix K
+  std::vector<SolverBody>& sb_;
+  std::vector<PointMatrix>& block_;  // pseudo-inverse of each contact's normal matrix K
+  std::vector<std::pair<double, std::uint32_t>>& order_;
 };
 
 // The collision pass of Guendelman, Bridson & Fedkiw 2003 (§5), with each contact's impact
@@ -270,8 +265,8 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   auto height = [&](std::uint32_t id) {
     return id == kStaticBody ? -INFINITY : up.dot(bodies_[id].s.x);
   };
-  std::vector<std::pair<double, std::uint32_t>> order;
-  order.reserve(contacts.size());
+  std::vector<std::pair<double, std::uint32_t>>& order = order_;
+  order.clear();
   for (std::size_t i = 0; i < contacts.size(); ++i)
     order.emplace_back(std::min(height(contacts[i].a), height(contacts[i].b)),
                        static_cast<std::uint32_t>(i));
@@ -339,16 +334,17 @@ void Solver::solve_position(Contact& c, const SolverSettings& s, double dt) {
   }
 }
 
-void Solver::finish(double dt) {
+void Solver::finish() {
   for (std::size_t k = 0; k < ids_.size(); ++k) {
     Body& body = bodies_[ids_[k]];
     const SolverBody& s = sb_[k];
     body.s.P = body.c.mass * s.v;
     body.s.L = body.s.R * body.c.inertia.cwiseProduct(body.s.R.transpose() * s.w);
-    body.s.x += dt * (s.v + s.vp);
-    const Vec3 turn = dt * (s.w + s.wp);
-    if (!turn.isZero()) body.s.R = rotation_from_vector(turn) * body.s.R;
   }
+}
+
+void Solver::release() {
+  for (std::uint32_t id : ids_) index_[id] = -1;
 }
 
 }  // namespace
@@ -408,14 +404,14 @@ void warm_start_from(Contact& contact, const Contact& previous) {
   }
 }
 
-// One step of the bodies in contact, in the order of Guendelman, Bridson & Fedkiw 2003:
+// The velocities of the bodies in contact, in the order of Guendelman, Bridson & Fedkiw 2003:
 // gravity, the collision pass (impacts with restitution), the contact pass (sequential
-// impulses, e = 0), then positions with the corrected velocities — semi-implicit Euler, with
-// the split-impulse pseudo velocities added to the positions only.
+// impulses, e = 0); positions then follow in flight with the corrected velocities
+// (semi-implicit Euler), the split-impulse pseudo velocities added to the positions only.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
-                   const SolverSettings& settings, std::vector<std::int32_t>& index) {
-  Solver solver(bodies, solver_bodies, index);
+                   const SolverSettings& settings, SolverScratch& scratch) {
+  Solver solver(bodies, solver_bodies, scratch);
   for (std::uint32_t id : solver_bodies) {
     SolverBody* s = solver.body(id);
     s->v += dt * gravity;
@@ -429,7 +425,8 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt);
   for (int it = 0; it < settings.position_iterations; ++it)
     for (Contact& c : contacts) solver.solve_position(c, settings, dt);
-  solver.finish(dt);
+  solver.finish();
+  solver.release();
   return impacts;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
-/// Contacts between bodies (and between those bodies and the floor) and the solver that steps
-/// the bodies touching each other: exact impact impulses, then sequential impulses with warm
+/// Contacts between bodies (and between those bodies and the floor) and the solver of the
+/// bodies touching each other: exact impact impulses, then sequential impulses with warm
 /// starting and Coulomb friction, then split-impulse position correction.
 /// Pure functions over the caller's buffers; thread-safe.
 #include <array>
@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "active_set.hpp"
 #include "tumble/body.hpp"
 
 namespace tumble {
@@ -63,13 +64,33 @@ int floor_contact(const BodyState& s, const BodyConstants& c, std::uint32_t body
 /// Copies the accumulated impulses of points with the same feature id from `previous`.
 void warm_start_from(Contact& contact, const Contact& previous);
 
-/// Steps `bodies[solver_bodies]` by dt under gravity with the contacts: impacts (relative
-/// normal speed above the restitution threshold) get an exact simultaneous impulse per contact
-/// with restitution e; then sequential impulses with warm starting and friction keep resting
-/// contacts from approaching; positions follow by semi-implicit Euler with a split-impulse
-/// correction of deep penetration. `index` is scratch. Returns the number of impacts.
+/// Velocities of a body during the solve (I⁻¹ fixed at the start of the step).
+struct SolverBody {
+  Vec3 v = Vec3::Zero();            ///< m/s.
+  Vec3 w = Vec3::Zero();            ///< rad/s.
+  Vec3 vp = Vec3::Zero();           ///< Split-impulse pseudo velocity, m/s.
+  Vec3 wp = Vec3::Zero();           ///< Split-impulse pseudo angular velocity, rad/s.
+  Mat3 inv_inertia = Mat3::Zero();  ///< World I⁻¹ at the step start, 1/(kg·m²).
+  double inv_mass = 0.0;            ///< 1/kg.
+};
+
+/// The solver's buffers, reused between steps.
+struct SolverScratch {
+  std::vector<SolverBody> bodies;     ///< One per solver body, in the order given.
+  std::vector<std::int32_t> index;    ///< Body id → position in `bodies`, −1 when absent.
+  std::vector<PointMatrix> blocks;    ///< Pseudo-inverse of each contact's normal matrix K.
+  std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
+};
+
+/// Solves the velocities of `bodies[solver_bodies]` over dt under gravity with the contacts:
+/// impacts (relative normal speed above the restitution threshold) get an exact simultaneous
+/// impulse per contact with restitution e; then sequential impulses with warm starting and
+/// friction keep resting contacts from approaching; a split-impulse pass finds the pseudo
+/// velocities that remove deep penetration. Writes the bodies' end-of-step momenta P, L (their
+/// positions are flight's job) and leaves v, w, vp, wp in scratch.bodies. Returns the number
+/// of impacts.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
-                   const SolverSettings& settings, std::vector<std::int32_t>& index);
+                   const SolverSettings& settings, SolverScratch& scratch);
 
 }  // namespace tumble

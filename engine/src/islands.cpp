@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "pipeline.hpp"
+
 namespace tumble {
 
 void UnionFind::reset(std::size_t n) {
@@ -27,31 +29,57 @@ void UnionFind::unite(std::uint32_t a, std::uint32_t b) {
 
 // Islands as in Box2D (Catto 2023, "Simulation islands"): contacts are the edges of a graph
 // over bodies; its connected components move, sleep and wake together, because an impulse
-// anywhere in a stack reaches every body of it within one solve.
-std::vector<std::vector<std::uint32_t>> build_islands(std::size_t body_count,
-                                                      std::span<const BodyPair> links,
-                                                      UnionFind& sets,
-                                                      std::vector<std::int32_t>& island) {
-  sets.reset(body_count);
-  island.assign(body_count, -1);
-  std::vector<std::uint8_t> linked(body_count, 0);
-  for (const BodyPair& p : links) {
-    sets.unite(p.first, p.second);
-    linked[p.first] = linked[p.second] = 1;
-  }
-  std::vector<std::vector<std::uint32_t>> islands;
-  std::vector<std::int32_t> root_island(body_count, -1);
+// anywhere in a stack reaches every body of it within one solve. Two passes over the linked
+// bodies in ascending order (count, then place) give the compressed lists without sorting.
+void build_islands(std::size_t body_count, std::span<const BodyPair> links, IslandScratch& out) {
+  out.sets.reset(body_count);
+  out.island_of.assign(body_count, -1);
+  for (const BodyPair& p : links) out.sets.unite(p.first, p.second);
+  // Linked bodies are marked −2 first; the root's island number is taken when met first.
+  for (const BodyPair& p : links) out.island_of[p.first] = out.island_of[p.second] = -2;
+  out.offset.assign(1, 0);
+  std::vector<std::int32_t>& of = out.island_of;
   for (std::uint32_t i = 0; i < body_count; ++i) {
-    if (!linked[i]) continue;
-    const std::uint32_t r = sets.find(i);
-    if (root_island[r] < 0) {
-      root_island[r] = static_cast<std::int32_t>(islands.size());
-      islands.emplace_back();
+    if (of[i] == -1) continue;
+    const std::uint32_t r = out.sets.find(i);
+    if (r == i) {  // the smallest member is the root: a new island
+      of[i] = static_cast<std::int32_t>(out.offset.size() - 1);
+      out.offset.push_back(0);
+    } else {
+      of[i] = of[r];
     }
-    island[i] = root_island[r];
-    islands[root_island[r]].push_back(i);
+    ++out.offset[of[i] + 1];
   }
-  return islands;
+  for (std::size_t k = 1; k < out.offset.size(); ++k) out.offset[k] += out.offset[k - 1];
+  out.members.resize(out.offset.back());
+  out.cursor.assign(out.offset.begin(), out.offset.end() - 1);
+  for (std::uint32_t i = 0; i < body_count; ++i)
+    if (of[i] >= 0) out.members[out.cursor[of[i]]++] = i;
+}
+
+void islands(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  const std::size_t n = ctx.bodies.size();
+  s.solver_bodies.clear();
+  s.lone_bodies.clear();
+  if (s.links.empty()) {
+    s.island.offset.clear();
+  } else {
+    build_islands(n, s.links, s.island);
+    s.solver_bodies.assign(s.island.members.begin(), s.island.members.end());
+    std::sort(s.solver_bodies.begin(), s.solver_bodies.end());
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (ctx.bodies[i].activity == Activity::awake &&
+        (s.links.empty() || s.island.island_of[i] < 0))
+      s.lone_bodies.push_back(static_cast<std::uint32_t>(i));
+  s.stepped = s.solver_bodies;
+  s.stepped.insert(s.stepped.end(), s.lone_bodies.begin(), s.lone_bodies.end());
+  s.before.clear();
+  for (std::uint32_t id : s.stepped) s.before.push_back(ctx.bodies[id].s);
+  ctx.stats.islands = static_cast<std::uint32_t>(s.island.count());
+  ctx.stats.solver_bodies = static_cast<std::uint32_t>(s.solver_bodies.size());
+  ctx.stats.awake = static_cast<std::uint32_t>(s.stepped.size());
 }
 
 }  // namespace tumble

@@ -25,12 +25,24 @@ class UnionFind {
   std::vector<std::uint32_t> parent_;
 };
 
-/// The islands of `bodies` linked by `links`: island[i] is the index (into the returned list
-/// of member lists) of body i's island, for the bodies that appear in a link; others get -1.
-/// Islands are numbered by their smallest body index, members listed in ascending order.
-std::vector<std::vector<std::uint32_t>> build_islands(std::size_t body_count,
-                                                      std::span<const BodyPair> links,
-                                                      UnionFind& sets,
-                                                      std::vector<std::int32_t>& island);
+/// Islands of linked bodies in compressed form, reused between steps (no allocation once
+/// warm). Island k's members are members[offset[k] .. offset[k + 1]), ascending; islands are
+/// numbered by their smallest body index.
+struct IslandScratch {
+  UnionFind sets;                       ///< Union–find over all bodies.
+  std::vector<std::int32_t> island_of;  ///< Island of each body, −1 when in no link.
+  std::vector<std::uint32_t> members;   ///< Bodies of all islands, island by island.
+  std::vector<std::uint32_t> offset;    ///< Start of each island in members, plus the end.
+  std::vector<std::uint32_t> cursor;    ///< Fill position of each island while building.
+  /// Number of islands.
+  std::size_t count() const { return offset.empty() ? 0 : offset.size() - 1; }
+  /// Members of island k.
+  std::span<const std::uint32_t> island(std::size_t k) const {
+    return {members.data() + offset[k], members.data() + offset[k + 1]};
+  }
+};
+
+/// Fills `out` with the islands of `body_count` bodies linked by `links`.
+void build_islands(std::size_t body_count, std::span<const BodyPair> links, IslandScratch& out);
 
 }  // namespace tumble

@@ -1,43 +1,27 @@
 #include "tumble/world.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <string>
 
-#include "contact_stage.hpp"
 #include "floor_contact.hpp"
-#include "integrators.hpp"
+#include "pipeline.hpp"
 
 namespace tumble {
 namespace {
 
-constexpr double kSleepSpeed = 0.01;  // m/s: fastest point of a body that may fall asleep.
-constexpr double kSleepTime = 0.5;    // s of stillness in contact before sleeping.
+// A contact with a sleeping island wakes it; its bodies then need their own contacts, so the
+// detection stages repeat (rarely more than once) until nothing new wakes.
+constexpr int kMaxWakeRounds = 8;
 
-/// Stage: a body that has been slow while touching the floor for kSleepTime falls asleep
-/// (its momenta are zeroed, so it is exactly still); Box2D's rule, Catto 2023 "islands".
-void update_sleep(Body& b, bool touched, double dt) {
-  if (!touched) {
-    b.still_time = 0.0;
-    return;
-  }
-  const double speed = (b.s.P * b.c.inv_mass).norm() +
-                       angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
-  if (speed > kSleepSpeed) {
-    b.still_time = 0.0;
-    return;
-  }
-  b.still_time += dt;
-  if (b.still_time >= kSleepTime) {
-    b.activity = Activity::asleep;
-    b.s.P.setZero();
-    b.s.L.setZero();
-  }
-}
-
-/// Stage: the cheap finiteness check; a body that went non-finite keeps its last finite
-/// state and is frozen (MuJoCo's mj_checkPos idea), so nothing passes a NaN on.
-bool state_finite(const BodyState& s) {
-  return std::isfinite(s.x.sum() + s.P.sum() + s.L.sum() + s.R.sum());
+/// Runs one stage and, when the World times its stages, adds its wall time to the counters.
+void run_stage(Stage stage, void (*run)(StepContext&), StepContext& ctx, bool timed) {
+  if (!timed) return run(ctx);
+  const auto start = std::chrono::steady_clock::now();
+  run(ctx);
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::steady_clock::now() - start);
+  ctx.stats.stage_ns[static_cast<int>(stage)] += static_cast<std::uint64_t>(ns.count());
 }
 
 void require_finite(const Vec3& v, const char* what) {
@@ -61,8 +45,10 @@ World::World(Scene scene) : scene_(std::move(scene)) {
     if (w.floor && rests_on_face(b.s, b.c, w.floor->height)) b.activity = Activity::asleep;
     bodies_.push_back(b);
   }
-  contact_ = std::make_unique<ContactState>();
-  init_contact_state(*contact_, bodies_.size());
+  cache_ = std::make_unique<ContactCache>();
+  broad_ = std::make_unique<BroadPhaseCache>();
+  scratch_ = std::make_unique<StepScratch>();
+  init_caches(*cache_, bodies_.size());
 }
 
 World::World(const World& other)
@@ -72,7 +58,10 @@ World::World(const World& other)
       steps_(other.steps_),
       total_impacts_(other.total_impacts_),
       last_(other.last_),
-      contact_(std::make_unique<ContactState>(*other.contact_)) {}
+      time_stages_(other.time_stages_),
+      cache_(std::make_unique<ContactCache>(*other.cache_)),
+      broad_(std::make_unique<BroadPhaseCache>()),
+      scratch_(std::make_unique<StepScratch>()) {}
 
 World& World::operator=(const World& other) {
   if (this != &other) *this = World(other);
@@ -85,34 +74,21 @@ World::~World() = default;
 
 void World::step() { step(scene_.world.dt); }
 
+// The step as a list of stages (engine/src/pipeline.hpp says what each does and where).
 void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0)) throw InvalidInput("dt must be finite and > 0");
   last_ = {};
-  const WorldDef& w = scene_.world;
-  const bool renormalize = (steps_ + 1) % kGramSchmidtInterval == 0;
-  // Body–body contact runs only when two bodies can touch; otherwise every body takes the
-  // floor-only path below, bit for bit as without it.
-  const bool contacts = find_contacts(*contact_, bodies_, w, dt, last_);
-  for (std::size_t i = 0; i < bodies_.size(); ++i) {
-    Body& b = bodies_[i];
-    if (b.activity != Activity::awake || contact_->in_solver[i]) continue;
-    ++last_.awake;
-    const BodyState before = b.s;
-    const FloorStepResult r = advance_with_floor(b, w, dt);
-    last_.impacts += r.impacts;
-    last_.toi_iterations += r.toi_iterations;
-    b.in_contact = r.touched;
-    if (!state_finite(b.s)) {
-      b.s = before;
-      b.activity = Activity::frozen;
-      ++last_.newly_frozen;
-      continue;
-    }
-    if (renormalize) gram_schmidt(b.s.R);
-    update_sleep(b, r.touched, dt);
-    if (b.activity == Activity::asleep) sleep_alone(*contact_, static_cast<std::uint32_t>(i));
+  StepContext ctx{scene_.world, dt, steps_, bodies_, *cache_, *broad_, *scratch_, last_};
+  for (int round = 0; round < kMaxWakeRounds; ++round) {
+    run_stage(Stage::broad_phase, broad_phase, ctx, time_stages_);
+    run_stage(Stage::narrow_phase, narrow_phase, ctx, time_stages_);
+    if (ctx.scratch.woken == 0) break;
   }
-  if (contacts) step_contacts(*contact_, bodies_, w, dt, renormalize, last_);
+  run_stage(Stage::islands, islands, ctx, time_stages_);
+  run_stage(Stage::contact_solve, contact_solve, ctx, time_stages_);
+  run_stage(Stage::flight, flight, ctx, time_stages_);
+  run_stage(Stage::finalize, finalize, ctx, time_stages_);
+  run_stage(Stage::sleep, update_sleep, ctx, time_stages_);
   total_impacts_ += last_.impacts;
   time_ += dt;
   ++steps_;
@@ -126,13 +102,15 @@ void World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3& point) {
   if (b.activity == Activity::frozen) throw InvalidInput("body is frozen (it went non-finite)");
   b.s.P += impulse;
   b.s.L += (point - b.s.x).cross(impulse);
-  wake_island(*contact_, bodies_, id);
+  wake_island(*cache_, bodies_, id);
 }
 
 void World::apply_impulse(BodyId id, const Vec3& impulse) {
   body(id);
   apply_impulse(id, impulse, bodies_[id].s.x);
 }
+
+void World::set_stage_timing(bool on) { time_stages_ = on; }
 
 void World::set_integrator(Integrator integrator) { scene_.world.integrator = integrator; }
 

@@ -12,7 +12,7 @@ enum class Stage : std::uint8_t {
   narrow_phase,  ///< Box–box and box–floor manifolds of those pairs; waking touched islands.
   islands,       ///< Bodies linked by contacts; a lone body is an island of one.
   contact_solve, ///< Impacts, friction and non-penetration impulses of the islands.
-  flight,        ///< Every awake body moved with the scene's integrator.
+  flight,        ///< Every awake body moved over dt (lone bodies: the scene's integrator).
   finalize,      ///< Finiteness (freeze) and re-orthonormalisation.
   sleep,         ///< Islands that have been still long enough fall asleep.
 };

@@ -1,0 +1,114 @@
+#include <algorithm>
+#include <cmath>
+
+#include "box_box.hpp"
+#include "pipeline.hpp"
+
+namespace tumble {
+namespace {
+
+// A body pair joins the contact solve only when a point of its manifold is closer than this
+// (m) or will close its gap within the step at the current velocities. Pairs that merely pass
+// near each other keep the lone path with the scene's exact integrator.
+constexpr double kTouchDistance = 1e-3;
+
+/// True when some point of the manifold touches or will touch within dt.
+bool touches(const BoxManifold& m, const Body& a, const Body& b, double dt) {
+  const Vec3 va = a.s.P * a.c.inv_mass, vb = b.s.P * b.c.inv_mass;
+  const Vec3 wa = angular_velocity(a.s, a.c), wb = angular_velocity(b.s, b.c);
+  for (int i = 0; i < m.count; ++i) {
+    const Vec3& p = m.points[i].position;
+    const double vn = (vb + wb.cross(p - b.s.x) - va - wa.cross(p - a.s.x)).dot(m.normal);
+    if (m.points[i].separation + std::min(vn, 0.0) * dt <= kTouchDistance) return true;
+  }
+  return false;
+}
+
+/// Fastest point of a body: |v| + |ω| r, m/s.
+double point_speed_bound(const Body& b) {
+  return b.s.P.norm() * b.c.inv_mass + angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
+}
+
+Contact contact_of(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const Body& ba,
+                   const Body& bb) {
+  Contact c;
+  c.a = a;
+  c.b = b;
+  c.normal = m.normal;
+  c.friction = std::sqrt(ba.c.friction * bb.c.friction);
+  c.restitution = std::max(ba.c.restitution, bb.c.restitution);
+  c.count = m.count;
+  for (int i = 0; i < m.count; ++i) {
+    c.points[i].position = m.points[i].position;
+    c.points[i].separation = m.points[i].separation;
+    c.points[i].id = m.points[i].id;
+  }
+  return c;
+}
+
+/// Box–box manifolds of the broad-phase pairs; wakes the sleeping islands they touch.
+void collide_pairs(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  const double dt = ctx.dt;
+  s.box_contacts.clear();
+  s.links.clear();
+  s.woken = 0;
+  for (const BodyPair& p : s.pairs) {
+    Body& a = ctx.bodies[p.first];
+    Body& b = ctx.bodies[p.second];
+    const double closing = dt * ((a.s.P * a.c.inv_mass - b.s.P * b.c.inv_mass).norm() +
+                                 angular_velocity(a.s, a.c).norm() * a.c.bounding_radius +
+                                 angular_velocity(b.s, b.c).norm() * b.c.bounding_radius);
+    const BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
+    if (m.count == 0 || !touches(m, a, b, dt)) continue;
+    s.box_contacts.push_back(contact_of(m, p.first, p.second, a, b));
+    s.links.push_back(p);
+    for (const std::uint32_t id : {p.first, p.second}) {
+      if (ctx.bodies[id].activity != Activity::asleep) continue;
+      wake_island(ctx.cache, ctx.bodies, id);
+      ++s.woken;
+    }
+  }
+  s.linked.clear();
+  for (const BodyPair& p : s.links) s.linked.insert(s.linked.end(), {p.first, p.second});
+  std::sort(s.linked.begin(), s.linked.end());
+  s.linked.erase(std::unique(s.linked.begin(), s.linked.end()), s.linked.end());
+}
+
+// The floor joins the same solve as a static body, so a stack's bottom box feels both its
+// load and the floor in one consistent set of impulses. Floor contacts go first: Gauss–
+// Seidel then carries the support up the stack within one sweep. A body struck from above can
+// be driven down faster than it moves now: its floor margin also covers the speed of the
+// fastest body touching it.
+void collide_floor(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  s.contacts.clear();
+  if (!ctx.world.floor || s.box_contacts.empty()) return;
+  s.reach.resize(ctx.bodies.size());
+  for (std::uint32_t id : s.linked) s.reach[id] = 0.0;
+  for (const Contact& c : s.box_contacts) {
+    s.reach[c.a] = std::max(s.reach[c.a], point_speed_bound(ctx.bodies[c.b]));
+    s.reach[c.b] = std::max(s.reach[c.b], point_speed_bound(ctx.bodies[c.a]));
+  }
+  for (std::uint32_t id : s.linked) {
+    const Body& b = ctx.bodies[id];
+    const double margin = kSpeculativeDistance + ctx.dt * (point_speed_bound(b) + s.reach[id]);
+    Contact c;
+    if (floor_contact(b.s, b.c, id, ctx.world.floor->height, margin, c) > 0)
+      s.contacts.push_back(c);
+  }
+}
+
+}  // namespace
+
+void narrow_phase(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  collide_pairs(ctx);
+  collide_floor(ctx);
+  s.contacts.insert(s.contacts.end(), s.box_contacts.begin(), s.box_contacts.end());
+  ctx.stats.contacts = static_cast<std::uint32_t>(s.box_contacts.size());
+  ctx.stats.contact_points = 0;
+  for (const Contact& c : s.box_contacts) ctx.stats.contact_points += c.count;
+}
+
+}  // namespace tumble

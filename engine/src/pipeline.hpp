@@ -1,0 +1,109 @@
+#pragma once
+/// The stages of World::step and the data they share. Every stage is a free function of one
+/// signature, `void stage(StepContext&)`, in a file of its own (MuJoCo's mj_step and Box2D's
+/// b2World_Step as models):
+///
+///   broad_phase   → broad_phase.cpp   pairs of bodies whose swept boxes overlap
+///   narrow_phase  → narrow_phase.cpp  box–box manifolds; box–floor manifolds of bodies in them
+///   islands       → islands.cpp       bodies linked by contacts; a lone body is an island of one
+///   contact_solve → contact_solver.cpp impacts, friction, non-penetration of the islands
+///   flight        → flight.cpp        every awake body moved over dt
+///   finalize      → finalize.cpp      finiteness (freeze) and re-orthonormalisation
+///   update_sleep  → sleep.cpp         one rule: an island still for long enough sleeps
+///
+/// Not thread-safe: the World's owner thread runs the stages.
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "broad_phase.hpp"
+#include "contact_solver.hpp"
+#include "islands.hpp"
+#include "tumble/body.hpp"
+#include "tumble/scene.hpp"
+#include "tumble/step_stats.hpp"
+
+namespace tumble {
+
+/// What persists between steps and decides results: copied with the World.
+struct ContactCache {
+  /// Ring of each sleeping island: sleep_next[i] is the next member (i itself when alone).
+  std::vector<std::uint32_t> sleep_next;
+  /// Last step's contacts, for warm starting.
+  std::vector<Contact> previous;
+  /// (pair key, index into previous), sorted by key.
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> previous_keys;
+};
+
+/// Broad-phase acceleration kept between steps. It never changes a result (the pairs come out
+/// sorted whatever the cache held), so a World's copy starts without it.
+struct BroadPhaseCache {
+  SweepScratch sweep;                    ///< Sweep-and-prune orders.
+  std::vector<Aabb> boxes;               ///< Each body's swept box this step.
+  std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
+  std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
+  std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
+  std::uint64_t fat_signature = 0;       ///< Activity flags the fat pairs were found for.
+};
+
+/// Buffers of one step, reused between steps so that a step allocates nothing once warm.
+/// Holds no result: a World's copy starts with empty scratch.
+struct StepScratch {
+  std::vector<std::uint8_t> active;     ///< Body is awake this step.
+  std::vector<std::uint8_t> candidate;  ///< Body may touch anything (finite, not frozen).
+  std::vector<BodyPair> pairs;          ///< Broad-phase pairs (sorted).
+  std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
+  std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.
+  std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
+  std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
+  std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
+  int woken = 0;                        ///< Sleeping bodies the narrow phase woke.
+  IslandScratch island;                 ///< Union–find and island lists.
+  std::vector<std::uint32_t> solver_bodies;  ///< Bodies in islands of two or more, ascending.
+  std::vector<std::uint32_t> lone_bodies;    ///< Awake bodies touching no other body.
+  std::vector<std::uint32_t> stepped;        ///< solver_bodies then lone_bodies.
+  std::vector<BodyState> before;             ///< State of stepped[k] at the step start.
+  SolverScratch solver;                      ///< The contact solver's per-body data.
+};
+
+/// Everything a stage reads and writes.
+struct StepContext {
+  const WorldDef& world;     ///< Settings (gravity, floor, integrator, TOI method).
+  double dt;                 ///< Step, s.
+  std::uint64_t step_index;  ///< Steps taken before this one.
+  std::span<Body> bodies;    ///< All bodies, by BodyId.
+  ContactCache& cache;       ///< Persistent contact and sleep data.
+  BroadPhaseCache& broad;    ///< Broad-phase acceleration.
+  StepScratch& scratch;      ///< This step's buffers.
+  StepStats& stats;          ///< This step's counters.
+};
+
+/// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island).
+void init_caches(ContactCache& cache, std::size_t body_count);
+
+/// Stage: swept boxes of the candidates and the pairs whose boxes overlap (scratch.pairs).
+void broad_phase(StepContext& ctx);
+/// Stage: box–box manifolds of the pairs that touch within the step (scratch.contacts),
+/// waking the sleeping islands they reach (scratch.woken counts them), and the floor
+/// manifolds of the bodies in those contacts.
+void narrow_phase(StepContext& ctx);
+/// Stage: islands of touching bodies (scratch.solver_bodies); every other awake body is an
+/// island of one (scratch.lone_bodies); start states kept for finalize (scratch.before).
+void islands(StepContext& ctx);
+/// Stage: impulses of the islands' contacts; leaves the islands' momenta at the end of the
+/// step and their split-impulse pseudo velocities in scratch.solver.
+void contact_solve(StepContext& ctx);
+/// Stage: moves every awake body over dt: a lone body with the scene's integrator and its
+/// floor impacts at their time of impact, an island body with its solved velocities.
+void flight(StepContext& ctx);
+/// Stage: freezes bodies that went non-finite (restoring their start state) and
+/// re-orthonormalises R every kGramSchmidtInterval steps.
+void finalize(StepContext& ctx);
+/// Stage: one sleep rule for every island (a lone body is an island of one).
+void update_sleep(StepContext& ctx);
+
+/// Wakes body id and every body of its sleeping island.
+void wake_island(ContactCache& cache, std::span<Body> bodies, std::uint32_t id);
+
+}  // namespace tumble

@@ -1,0 +1,71 @@
+#include "pipeline.hpp"
+
+namespace tumble {
+namespace {
+
+// One rule for every island, a lone body being an island of one (Box2D v3's rule, Catto 2023
+// "Simulation islands"): a body is still while it touches something and its fastest point
+// moves slower than kSleepSpeed; an island whose bodies have all been still for kSleepTime
+// sleeps as a whole, with its momenta zeroed so that it is exactly at rest.
+constexpr double kSleepSpeed = 0.05;  // m/s
+constexpr double kSleepTime = 0.5;    // s
+
+/// Fastest point of a body: |v| + |ω| r, m/s.
+double point_speed_bound(const Body& b) {
+  return b.s.P.norm() * b.c.inv_mass + angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
+}
+
+void update_still_time(Body& b, double dt) {
+  if (b.activity != Activity::awake) return;
+  b.still_time = b.in_contact && point_speed_bound(b) <= kSleepSpeed ? b.still_time + dt : 0.0;
+}
+
+bool ready_to_sleep(const Body& b) {
+  return b.activity == Activity::awake && b.still_time >= kSleepTime;
+}
+
+/// Puts the island `members` to sleep as one ring.
+void fall_asleep(ContactCache& cache, std::span<Body> bodies,
+                 std::span<const std::uint32_t> members) {
+  for (std::size_t n = 0; n < members.size(); ++n) {
+    Body& b = bodies[members[n]];
+    b.activity = Activity::asleep;
+    b.s.P.setZero();
+    b.s.L.setZero();
+    cache.sleep_next[members[n]] = members[(n + 1) % members.size()];
+  }
+}
+
+}  // namespace
+
+void init_caches(ContactCache& cache, std::size_t body_count) {
+  cache.sleep_next.resize(body_count);
+  for (std::size_t i = 0; i < body_count; ++i) cache.sleep_next[i] = static_cast<std::uint32_t>(i);
+}
+
+void wake_island(ContactCache& cache, std::span<Body> bodies, std::uint32_t id) {
+  std::uint32_t i = id;
+  do {
+    Body& b = bodies[i];
+    if (b.activity == Activity::asleep) b.activity = Activity::awake;
+    b.still_time = 0.0;
+    const std::uint32_t next = cache.sleep_next[i];
+    cache.sleep_next[i] = i;
+    i = next;
+  } while (i != id);
+}
+
+void update_sleep(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  for (std::uint32_t id : s.stepped) update_still_time(ctx.bodies[id], ctx.dt);
+  for (std::size_t k = 0; k < s.island.count(); ++k) {
+    const std::span<const std::uint32_t> members = s.island.island(k);
+    bool still = true;
+    for (std::uint32_t id : members) still = still && ready_to_sleep(ctx.bodies[id]);
+    if (still) fall_asleep(ctx.cache, ctx.bodies, members);
+  }
+  for (std::uint32_t id : s.lone_bodies)
+    if (ready_to_sleep(ctx.bodies[id])) fall_asleep(ctx.cache, ctx.bodies, {&id, 1});
+}
+
+}  // namespace tumble
