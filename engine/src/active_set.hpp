@@ -6,6 +6,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+#include "tumble/math.hpp"
 
 namespace tumble {
 
@@ -18,43 +21,114 @@ using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMa
 /// Per-point values (velocities, targets, impulses).
 using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActiveSetPoints, 1>;
 
-/// K⁺ of a symmetric positive semi-definite K, dropping eigenvalues below 1e-12 of the
-/// largest (the null space of a flat face's four contacts).
-inline PointMatrix pseudo_inverse(const PointMatrix& K) {
-  const Eigen::Index m = K.rows();
-  if (m == 1) return PointMatrix::Constant(1, 1, 1.0 / K(0, 0));
-  Eigen::SelfAdjointEigenSolver<PointMatrix> eig(K);
-  const PointVector lambda = eig.eigenvalues();
-  const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-  PointVector inv(m);
-  for (Eigen::Index a = 0; a < m; ++a) inv(a) = std::abs(lambda(a)) > cutoff ? 1.0 / lambda(a) : 0.0;
-  return eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
+/// Rows (1, α, β) of contact points: α, β their coordinates in the contact plane, m.
+using PlaneCoordinates =
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, kMaxActiveSetPoints, 3>;
+
+/// One side of a contact seen by the normal impulses: a body (or nothing, for the floor).
+struct ContactSide {
+  double inv_mass = 0.0;            ///< 1/kg.
+  Mat3 inv_inertia = Mat3::Zero();  ///< World I⁻¹, 1/(kg·m²).
+  Vec3 origin_offset = Vec3::Zero();///< The plane's origin minus the body's centre, m.
+};
+
+// The normal-impulse matrix of points that share one normal n has rank three at most:
+// Kᵢⱼ = Σ_sides m⁻¹ + (rᵢ × n)ᵀ I⁻¹ (rⱼ × n), and rᵢ × n depends on the point only through its
+// two coordinates (αᵢ, βᵢ) in the plane normal to n (the component along n drops out of the
+// cross product). So K = D S Dᵀ with D's rows dᵢ = (1, αᵢ, βᵢ) and S a 3×3 matrix (the
+// effective inverse mass of the patch's normal force and its two tipping moments). Its
+// pseudo-inverse follows in closed form from 3×3 algebra: for D of full column rank,
+// K⁺ = D G⁻¹ S⁻¹ G⁻¹ Dᵀ with G = DᵀD (write D = QR: K = Q (R S Rᵀ) Qᵀ). This replaces the
+// eigendecomposition of the m×m K (m up to 8) that used to dominate the contact solve.
+/// The normal-impulse system K = D S Dᵀ of points sharing one normal.
+struct NormalSystem {
+  PlaneCoordinates D;  ///< (1, α, β) of each point.
+  Mat3 S = Mat3::Zero();  ///< Patch inverse mass in those coordinates.
+  PointMatrix K;       ///< D S Dᵀ, 1/kg.
+};
+
+/// The system of points at `offsets` from a common plane origin (world vectors, m), normal n,
+/// between sides `a` and `b` (null: held fixed, as the floor is). t1, t2 span the plane.
+inline NormalSystem make_normal_system(const Vec3& n, const Vec3& t1, const Vec3& t2,
+                                       const Vec3* offsets, int count, const ContactSide* a,
+                                       const ContactSide* b) {
+  NormalSystem sys;
+  sys.D.resize(count, 3);
+  for (int i = 0; i < count; ++i) sys.D.row(i) << 1.0, offsets[i].dot(t1), offsets[i].dot(t2);
+  const Vec3 e1 = t1.cross(n), e2 = t2.cross(n);
+  for (const ContactSide* side : {a, b}) {
+    if (!side) continue;
+    Mat3 C;
+    C << side->origin_offset.cross(n), e1, e2;
+    sys.S += C.transpose() * side->inv_inertia * C;
+    sys.S(0, 0) += side->inv_mass;
+  }
+  sys.K = sys.D * sys.S * sys.D.transpose();
+  return sys;
+}
+
+/// K⁺ of K = D S Dᵀ (S symmetric positive definite): closed form when the points span the
+/// plane, else through the 3×3 eigendecomposition of G = DᵀD, dropping directions whose
+/// eigenvalue is below 1e-12 of the largest (collinear or coincident points).
+inline PointMatrix pseudo_inverse(const PlaneCoordinates& D, const Mat3& S) {
+  const Eigen::Index m = D.rows();
+  const Mat3 G = D.transpose() * D;
+  Mat3 P;  // K⁺ = D P Dᵀ
+  const double det = G.determinant();
+  if (det > 1e-10 * G(0, 0) * G(1, 1) * G(2, 2)) {
+    const Mat3 Gi = G.inverse();
+    P = Gi * S.inverse() * Gi;
+  } else {
+    Eigen::SelfAdjointEigenSolver<Mat3> eig(G);
+    const Vec3 lambda = eig.eigenvalues();
+    const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
+    // Keep the directions D spans: W = V_r Λ_r⁻¹, then P = W (V_rᵀ S V_r)⁻¹ Wᵀ.
+    using Basis = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
+    Basis V(3, 3), W(3, 3);
+    int r = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (lambda(k) <= cutoff) continue;
+      V.col(r) = eig.eigenvectors().col(k);
+      W.col(r) = eig.eigenvectors().col(k) / lambda(k);
+      ++r;
+    }
+    if (r == 0) return PointMatrix::Zero(m, m);
+    V.conservativeResize(3, r);
+    W.conservativeResize(3, r);
+    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> T =
+        V.transpose() * S * V;
+    P = W * T.inverse() * W.transpose();
+  }
+  return D * P * D.transpose();
 }
 
 /// Pseudo-inverses of the sub-matrices of one K met so far, keyed by the active set: within
 /// one impulse exchange K is fixed, so repeated solves (friction rounds) reuse them.
 class ActiveSetCache {
  public:
-  explicit ActiveSetCache(const PointMatrix& K) : K_(K) {}
+  explicit ActiveSetCache(const NormalSystem& system) : system_(system) {}
   /// The matrix solved.
-  const PointMatrix& K() const { return K_; }
+  const PointMatrix& K() const { return system_.K; }
   /// K⁺ restricted to the points in `mask` (bit i = point i), listed in idx[0..m).
   const PointMatrix& inverse(unsigned mask, const std::array<int, kMaxActiveSetPoints>& idx,
                              int m) {
     for (int c = 0; c < cached_; ++c)
       if (masks_[c] == mask) return inverses_[c];
-    PointMatrix Ka(m, m);
-    for (int a = 0; a < m; ++a)
-      for (int b = 0; b < m; ++b) Ka(a, b) = K_(idx[a], idx[b]);
     const int slot = cached_ < kCache ? cached_++ : (next_++ % kCache);
     masks_[slot] = mask;
-    inverses_[slot] = pseudo_inverse(Ka);
+    if (m == 1) {
+      inverses_[slot] = PointMatrix::Constant(1, 1, 1.0 / system_.K(idx[0], idx[0]));
+      return inverses_[slot];
+    }
+    PlaneCoordinates Da(m, 3);
+    for (int a = 0; a < m; ++a) Da.row(a) = system_.D.row(idx[a]);
+    inverses_[slot] = pseudo_inverse(Da, system_.S);
     return inverses_[slot];
   }
 
  private:
   static constexpr int kCache = 4;
-  PointMatrix K_;
+  const NormalSystem& system_;
   int cached_ = 0, next_ = 0;
   std::array<unsigned, kCache> masks_{};
   std::array<PointMatrix, kCache> inverses_;

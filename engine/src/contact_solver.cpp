@@ -80,35 +80,20 @@ class Solver {
       p.pseudo_impulse = 0.0;
     }
     if (block_.size() <= n) block_.resize(n + 1);
-    block_[n] = pseudo_inverse(normal_matrix_of(c, a, b));
-  }
-
-  static PointMatrix pseudo_inverse(const PointMatrix& K) {
-    if (K.rows() == 4) {
-      // The common case, a face patch: the fixed-size solver is several times faster.
-      const Eigen::Matrix4d K4 = K;
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> eig(K4);
-      const Eigen::Vector4d lambda = eig.eigenvalues();
-      const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-      Eigen::Vector4d inv;
-      for (int r = 0; r < 4; ++r) inv(r) = std::abs(lambda(r)) > cutoff ? 1.0 / lambda(r) : 0.0;
-      const Eigen::Matrix4d P = eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
-      return P;
+    if (c.count == 1) {
+      block_[n] = PointMatrix::Constant(1, 1, c.points[0].normal_mass);
+    } else {
+      const NormalSystem sys = normal_system_of(c, a, b);
+      block_[n] = tumble::pseudo_inverse(sys.D, sys.S);
     }
-    Eigen::SelfAdjointEigenSolver<PointMatrix> eig(K);
-    const PointVector lambda = eig.eigenvalues();
-    const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-    PointVector inv(K.rows());
-    for (int r = 0; r < K.rows(); ++r)
-      inv(r) = std::abs(lambda(r)) > cutoff ? 1.0 / lambda(r) : 0.0;
-    return eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose();
   }
 
   int impact(Contact& c, const Vec3& gravity, double dt);
   void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt);
-  /// K_ij = n·(change of the relative normal velocity at point i per unit impulse at j), 1/kg;
-  /// a or b null: that body is held fixed.
-  PointMatrix normal_matrix_of(const Contact& c, const SolverBody* a, const SolverBody* b) const;
+  /// K = D S Dᵀ, K_ij = n·(change of the relative normal velocity at point i per unit impulse
+  /// at j), 1/kg; a or b null: that body is held fixed.
+  static NormalSystem normal_system_of(const Contact& c, const SolverBody* a,
+                                       const SolverBody* b);
   void warm_start(Contact& c);
   void solve_velocity(Contact& c, std::size_t n, double dt);
   void solve_position(Contact& c, const SolverSettings& s, double dt);
@@ -163,8 +148,8 @@ int Solver::impact(Contact& c, const Vec3& gravity, double dt) {
   Contact sub = c;  // the touching points only
   sub.count = n;
   for (int i = 0; i < n; ++i) sub.points[i] = c.points[idx[i]];
-  const PointMatrix K = normal_matrix_of(sub, a, b);
-  ActiveSetCache cache(K);
+  const NormalSystem sys = normal_system_of(sub, a, b);
+  ActiveSetCache cache(sys);
   const PointVector impulse = solve_active_set(cache, vn.head(n), target.head(n));
   for (int i = 0; i < n; ++i) {
     if (impulse(i) <= 0.0) continue;
@@ -290,27 +275,30 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
       approaching = approaching || vn(k) < target(k) - 1e-9;
     }
     if (!approaching) continue;
-    ActiveSetCache cache(normal_matrix_of(c, a, b));
+    const NormalSystem sys = normal_system_of(c, a, b);
+    ActiveSetCache cache(sys);
     const PointVector impulse = solve_active_set(cache, vn, target);
     for (int k = 0; k < n; ++k)
       if (impulse(k) > 0.0) apply(a, b, c.points[k].ra, c.points[k].rb, impulse(k) * c.normal);
   }
 }
 
-PointMatrix Solver::normal_matrix_of(const Contact& c, const SolverBody* a,
-                                     const SolverBody* b) const {
-  PointMatrix K(c.count, c.count);
-  for (int i = 0; i < c.count; ++i) {
-    const ContactPoint& pi = c.points[i];
-    for (int j = 0; j < c.count; ++j) {
-      const ContactPoint& pj = c.points[j];
-      double k = 0.0;
-      if (a) k += a->inv_mass + c.normal.dot((a->inv_inertia * pj.ra.cross(c.normal)).cross(pi.ra));
-      if (b) k += b->inv_mass + c.normal.dot((b->inv_inertia * pj.rb.cross(c.normal)).cross(pi.rb));
-      K(i, j) = k;
-    }
-  }
-  return K;
+NormalSystem Solver::normal_system_of(const Contact& c, const SolverBody* a,
+                                      const SolverBody* b) {
+  // The plane's origin is the points' centroid; offsets from a body's centre are ra, rb.
+  Vec3 ra0 = Vec3::Zero(), rb0 = Vec3::Zero();
+  for (int i = 0; i < c.count; ++i) ra0 += c.points[i].ra, rb0 += c.points[i].rb;
+  ra0 /= c.count;
+  rb0 /= c.count;
+  std::array<Vec3, kMaxContactPoints> offsets;
+  for (int i = 0; i < c.count; ++i) offsets[i] = c.points[i].rb - rb0;
+  Vec3 t1, t2;
+  tangents(c.normal, t1, t2);
+  ContactSide side_a, side_b;
+  if (a) side_a = {a->inv_mass, a->inv_inertia, ra0};
+  if (b) side_b = {b->inv_mass, b->inv_inertia, rb0};
+  return make_normal_system(c.normal, t1, t2, offsets.data(), c.count, a ? &side_a : nullptr,
+                            b ? &side_b : nullptr);
 }
 
 // Split impulse (Catto, GDC 2006 notes; Bullet's splitImpulse): penetration beyond the slop is

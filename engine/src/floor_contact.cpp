@@ -69,15 +69,17 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
   return target;
 }
 
-/// The contacts' normal-impulse matrix K (Kᵢⱼ = normal velocity change at i per unit impulse
-/// at j); I⁻¹ is fixed within one impulse exchange.
-PointMatrix normal_matrix(const Kinematics& k, const ContactSet& set) {
-  const Vec3 up = Vec3::UnitY();
-  PointMatrix K(set.count, set.count);
-  for (int i = 0; i < set.count; ++i)
-    for (int j = 0; j < set.count; ++j)
-      K(i, j) = k.inv_mass + up.dot((k.inv_inertia * set.r[j].cross(up)).cross(set.r[i]));
-  return K;
+/// The contacts' normal-impulse system K = D S Dᵀ (active_set.hpp); I⁻¹ is fixed within one
+/// impulse exchange.
+NormalSystem normal_system(const Kinematics& k, const ContactSet& set) {
+  Vec3 origin = Vec3::Zero();
+  for (int i = 0; i < set.count; ++i) origin += set.r[i];
+  origin /= set.count;
+  std::array<Vec3, kMaxPoints> offsets;
+  for (int i = 0; i < set.count; ++i) offsets[i] = set.r[i] - origin;
+  const ContactSide body{k.inv_mass, k.inv_inertia, origin};
+  return make_normal_system(Vec3::UnitY(), Vec3::UnitX(), Vec3::UnitZ(), offsets.data(),
+                            set.count, nullptr, &body);
 }
 
 /// Applies the active-set normal impulses (active_set.hpp) and returns them per contact.
@@ -118,7 +120,8 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   const BodyState s0 = s;
   const Kinematics k0 = kinematics_of(s, c);
   Kinematics k = k0;
-  ActiveSetCache system(normal_matrix(k0, set));
+  const NormalSystem normal_sys = normal_system(k0, set);
+  ActiveSetCache system(normal_sys);
   Impulses normal = solve_normal(s, k, set, system, target);
   if (mu <= 0.0) return set.count;
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
