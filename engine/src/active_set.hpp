@@ -67,11 +67,10 @@ inline NormalSystem make_normal_system(const Vec3& n, const Vec3& t1, const Vec3
   return sys;
 }
 
-/// K⁺ of K = D S Dᵀ (S symmetric positive definite): closed form when the points span the
-/// plane, else through the 3×3 eigendecomposition of G = DᵀD, dropping directions whose
-/// eigenvalue is below 1e-12 of the largest (collinear or coincident points).
-inline PointMatrix pseudo_inverse(const PlaneCoordinates& D, const Mat3& S) {
-  const Eigen::Index m = D.rows();
+/// P with K⁺ = D P Dᵀ for K = D S Dᵀ (S symmetric positive definite): closed form when the
+/// points span the plane, else through the 3×3 eigendecomposition of G = DᵀD, dropping
+/// directions whose eigenvalue is below 1e-12 of the largest (collinear or coincident points).
+inline Mat3 pseudo_inverse_factor(const PlaneCoordinates& D, const Mat3& S) {
   const Mat3 G = D.transpose() * D;
   Mat3 P;  // K⁺ = D P Dᵀ
   const double det = G.determinant();
@@ -92,14 +91,19 @@ inline PointMatrix pseudo_inverse(const PlaneCoordinates& D, const Mat3& S) {
       W.col(r) = eig.eigenvectors().col(k) / lambda(k);
       ++r;
     }
-    if (r == 0) return PointMatrix::Zero(m, m);
+    if (r == 0) return Mat3::Zero();
     V.conservativeResize(3, r);
     W.conservativeResize(3, r);
     const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> T =
         V.transpose() * S * V;
     P = W * T.inverse() * W.transpose();
   }
-  return D * P * D.transpose();
+  return P;
+}
+
+/// K⁺ of K = D S Dᵀ as an m×m matrix.
+inline PointMatrix pseudo_inverse(const PlaneCoordinates& D, const Mat3& S) {
+  return D * pseudo_inverse_factor(D, S) * D.transpose();
 }
 
 /// Pseudo-inverses of the sub-matrices of one K met so far, keyed by the active set: within

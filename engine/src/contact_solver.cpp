@@ -80,11 +80,16 @@ class Solver {
       p.pseudo_impulse = 0.0;
     }
     if (block_.size() <= n) block_.resize(n + 1);
+    BlockInverse& block = block_[n];
     if (c.count == 1) {
-      block_[n] = PointMatrix::Constant(1, 1, c.points[0].normal_mass);
+      block.D.setZero(1, 3);
+      block.D(0, 0) = 1.0;
+      block.P.setZero();
+      block.P(0, 0) = c.points[0].normal_mass;
     } else {
       const NormalSystem sys = normal_system_of(c, a, b);
-      block_[n] = tumble::pseudo_inverse(sys.D, sys.S);
+      block.D = sys.D;
+      block.P = pseudo_inverse_factor(sys.D, sys.S);
     }
   }
 
@@ -112,7 +117,7 @@ class Solver {
   std::span<const std::uint32_t> ids_;
   std::vector<std::int32_t>& index_;
   std::vector<SolverBody>& sb_;
-  std::vector<PointMatrix>& block_;  // pseudo-inverse of each contact's normal matrix K
+  std::vector<BlockInverse>& block_;  // pseudo-inverse of each contact's normal matrix K
   std::vector<std::pair<double, std::uint32_t>>& order_;
 };
 
@@ -207,19 +212,25 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
   // Point-by-point Gauss–Seidel leaves such a patch rocking; the block step removes it. When
   // the block answer would pull at a point, the points fall back to one clamped sweep.
   const int n = c.count;
-  PointVector rhs(n), lambda(n);
+  const BlockInverse& block = block_[index];
+  std::array<double, kMaxContactPoints> next{};
+  Vec3 projected = Vec3::Zero();  // Dᵀ rhs
   for (int i = 0; i < n; ++i) {
     const ContactPoint& p = c.points[i];
     const double vn = (point_velocity(b, p.rb) - point_velocity(a, p.ra)).dot(c.normal);
-    rhs(i) = target_of(p, dt) - vn;
-    lambda(i) = p.normal_impulse;
+    projected += (target_of(p, dt) - vn) * block.D.row(i).transpose();
   }
-  const PointVector next = lambda + block_[index] * rhs;
-  if ((next.array() >= 0.0).all()) {
+  const Vec3 z = block.P * projected;
+  bool pushes = true;
+  for (int i = 0; i < n; ++i) {
+    next[i] = c.points[i].normal_impulse + block.D.row(i).dot(z);
+    pushes = pushes && next[i] >= 0.0;
+  }
+  if (pushes) {
     for (int i = 0; i < n; ++i) {
       ContactPoint& p = c.points[i];
-      const double delta = next(i) - p.normal_impulse;
-      p.normal_impulse = next(i);
+      const double delta = next[i] - p.normal_impulse;
+      p.normal_impulse = next[i];
       if (delta != 0.0) apply(a, b, p.ra, p.rb, delta * c.normal);
     }
     return;

@@ -74,11 +74,18 @@ struct SolverBody {
   double inv_mass = 0.0;            ///< 1/kg.
 };
 
+/// K⁺ = D P Dᵀ of one contact's normal-impulse matrix (active_set.hpp), kept factored: a
+/// product with it costs 6m + 9 multiplications instead of m².
+struct BlockInverse {
+  PlaneCoordinates D;     ///< (1, α, β) of each point.
+  Mat3 P = Mat3::Zero();  ///< The 3×3 middle factor.
+};
+
 /// The solver's buffers, reused between steps.
 struct SolverScratch {
   std::vector<SolverBody> bodies;     ///< One per solver body, in the order given.
   std::vector<std::int32_t> index;    ///< Body id → position in `bodies`, −1 when absent.
-  std::vector<PointMatrix> blocks;    ///< Pseudo-inverse of each contact's normal matrix K.
+  std::vector<BlockInverse> blocks;   ///< Pseudo-inverse of each contact's normal matrix K.
   std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
 };
 

@@ -1,0 +1,78 @@
+// The step pipeline (engine/src/pipeline.hpp): no allocation once warm, stage timings only
+// when asked for, copies that continue bit for bit without the caches they do not copy.
+#include <atomic>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+
+#include "world_fixture.hpp"
+
+namespace {
+// Every allocation of this test binary is counted (the count is what the test reads).
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+namespace tumble {
+namespace {
+
+using testing::bundled;
+
+// Box2D's and Jolt's rule: a step allocates nothing once its buffers have grown to the scene.
+// The pyramid's 210 boxes keep the same contacts while they stand (kept awake by a zero
+// impulse every 10 steps, which wakes their island), so after a short warm-up every buffer
+// has its size and 60 further steps must not allocate at all.
+TEST(Pipeline, StepAllocatesNothingOnceWarm) {
+  World world(bundled("pyramid"));
+  auto run = [&world](int steps) {
+    for (int i = 0; i < steps; ++i) {
+      if (world.step_count() % 10 == 0) world.apply_impulse(0, Vec3::Zero());
+      world.step();
+    }
+  };
+  const long at_start = g_allocations.load();
+  run(20);
+  ASSERT_GT(g_allocations.load() - at_start, 0);  // the counter sees the engine's buffers grow
+  ASSERT_GT(world.last_step().contacts, 100u);
+  const long before = g_allocations.load();
+  run(60);
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_GT(world.last_step().contacts, 100u);
+}
+
+TEST(Pipeline, StageTimesOnlyWhenAskedFor) {
+  World world(bundled("pyramid"));
+  world.step();
+  for (std::uint64_t ns : world.last_step().stage_ns) EXPECT_EQ(ns, 0u);
+  world.set_stage_timing(true);
+  world.step();
+  const StepStats& s = world.last_step();
+  EXPECT_GT(s.stage_ns[static_cast<int>(Stage::contact_solve)], 0u);
+  EXPECT_GT(s.stage_ns[static_cast<int>(Stage::narrow_phase)], 0u);
+  EXPECT_STREQ(stage_name(Stage::contact_solve), "contact_solve");
+}
+
+// A copy starts without the broad-phase acceleration and the scratch buffers; the results do
+// not depend on them, so the copy and the original stay bit-identical.
+TEST(Pipeline, CopyWithoutCachesContinuesBitForBit) {
+  World a(bundled("pile"));
+  for (int i = 0; i < 45; ++i) a.step();
+  World b = a;
+  for (int i = 0; i < 45; ++i) {
+    a.step();
+    b.step();
+  }
+  ASSERT_EQ(a.bodies().size(), b.bodies().size());
+  for (std::size_t i = 0; i < a.bodies().size(); ++i)
+    ASSERT_EQ(std::memcmp(&a.bodies()[i].s, &b.bodies()[i].s, sizeof(BodyState)), 0) << i;
+}
+
+}  // namespace
+}  // namespace tumble
