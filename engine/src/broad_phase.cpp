@@ -74,9 +74,9 @@ void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& 
 // sorted and insertion sort is about linear. Sleeping bodies do not move: they are sorted
 // once per change of the sleeping set, and each awake box finds the sleeping ones it may
 // touch by binary search over that list.
-void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
+bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
                 std::span<const std::uint8_t> candidate, SweepScratch& scratch,
-                std::vector<BodyPair>& pairs) {
+                std::vector<BodyPair>& pairs, std::size_t max_pairs) {
   pairs.clear();
   const std::size_t n = boxes.size();
   scratch.start.resize(n);
@@ -127,7 +127,8 @@ void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
     scratch.sleeping_signature = signature;
   }
   const std::vector<std::uint32_t>& sleeping = scratch.sleeping;
-  for (std::size_t i = 0; i < awake.size(); ++i) {
+  bool complete = true;
+  for (std::size_t i = 0; i < awake.size() && complete; ++i) {
     const std::uint32_t a = awake[i];
     const Aabb& ba = boxes[a];
     const double end = interval_end(ba);
@@ -143,8 +144,13 @@ void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
                                   [&](std::uint32_t s, double v) { return scratch.start[s] < v; });
     for (auto it = first; it != sleeping.end() && scratch.start[*it] <= end; ++it)
       if (overlap(ba, boxes[*it])) add_pair(pairs, a, *it);
+    if (pairs.size() > max_pairs) {
+      pairs.resize(max_pairs);
+      complete = false;
+    }
   }
   std::sort(pairs.begin(), pairs.end());
+  return complete;
 }
 
 }  // namespace tumble
@@ -216,11 +222,29 @@ void broad_phase(StepContext& ctx) {
       k.fat[i] = {k.boxes[i].lo.array() - margin, k.boxes[i].hi.array() + margin};
     }
     k.fat_signature = signature;
-    find_pairs(k.fat, s.active, s.candidate, k.sweep, k.fat_pairs);
+    k.fat_complete = find_pairs(k.fat, s.active, s.candidate, k.sweep, k.fat_pairs,
+                                pair_budget(n));
   }
   for (const BodyPair& p : k.fat_pairs)
     if (overlaps(k.boxes[p.first], k.boxes[p.second])) s.pairs.push_back(p);
   ctx.stats.pairs = static_cast<std::uint32_t>(s.pairs.size());
+  ctx.stats.pair_budget_exceeded = k.fat_complete ? 0 : 1;
+}
+
+}  // namespace tumble
+
+namespace tumble {
+
+std::size_t initial_pairs(std::span<const Body> bodies, const Vec3& gravity) {
+  const std::size_t n = bodies.size();
+  std::vector<Aabb> boxes(n);
+  std::vector<std::uint8_t> active(n, 1), candidate(n, 1);
+  for (std::size_t i = 0; i < n; ++i)
+    boxes[i] = swept_aabb(bodies[i].s, bodies[i].c, gravity, 0.0, 0.5 * kSpeculativeDistance);
+  SweepScratch sweep;
+  std::vector<BodyPair> pairs;
+  find_pairs(boxes, active, candidate, sweep, pairs, pair_budget(n) + 1);
+  return pairs.size();
 }
 
 }  // namespace tumble

@@ -40,9 +40,15 @@ struct SweepScratch {
 /// stay asleep), in ascending (first, second) order. `candidate[i]` false leaves body i out
 /// entirely (frozen bodies). Cost: the awake bodies re-sort in about linear time (insertion
 /// sort on last step's order); the sleeping ones are sorted only when their set changes and
-/// are found by binary search, so 10,000 sleeping boxes cost nothing per step.
-void find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
+/// are found by binary search, so 10,000 sleeping boxes cost nothing per step. Stops after
+/// `max_pairs` pairs (a bound on the memory and time one step can take when a scene packs
+/// bodies into one another) and returns false then; true when every pair was found.
+bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
                 std::span<const std::uint8_t> candidate, SweepScratch& scratch,
-                std::vector<BodyPair>& pairs);
+                std::vector<BodyPair>& pairs, std::size_t max_pairs);
+
+/// The pair budget of a world of `body_count` bodies: 32 per body plus 1,024. A resting pile
+/// has about 7 per body (`pile`: 6,852 pairs for 1,000 bodies at most).
+inline std::size_t pair_budget(std::size_t body_count) { return 32 * body_count + 1024; }
 
 }  // namespace tumble

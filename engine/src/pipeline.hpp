@@ -45,6 +45,7 @@ struct BroadPhaseCache {
   std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
   std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
   std::uint64_t fat_signature = 0;       ///< Activity flags the fat pairs were found for.
+  bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
 };
 
 /// Buffers of one step, reused between steps so that a step allocates nothing once warm.
@@ -102,6 +103,9 @@ void flight(StepContext& ctx);
 void finalize(StepContext& ctx);
 /// Stage: one sleep rule for every island (a lone body is an island of one).
 void update_sleep(StepContext& ctx);
+
+/// Pairs of bodies whose boxes overlap as placed (stops counting just past pair_budget).
+std::size_t initial_pairs(std::span<const Body> bodies, const Vec3& gravity);
 
 /// Wakes body id and every body of its sleeping island.
 void wake_island(ContactCache& cache, std::span<Body> bodies, std::uint32_t id);

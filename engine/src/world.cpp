@@ -45,6 +45,11 @@ World::World(Scene scene) : scene_(std::move(scene)) {
     if (w.floor && rests_on_face(b.s, b.c, w.floor->height)) b.activity = Activity::asleep;
     bodies_.push_back(b);
   }
+  // A scene that packs its bodies into one another costs memory and time quadratic in their
+  // number (2,000 boxes at one point: two million pairs); beyond the pair budget it is refused.
+  if (initial_pairs(bodies_, w.gravity) > pair_budget(bodies_.size()))
+    throw InvalidInput("bodies: more than " + std::to_string(pair_budget(bodies_.size())) +
+                       " pairs of bodies overlap as placed (the limit is 32 per body + 1024)");
   cache_ = std::make_unique<ContactCache>();
   broad_ = std::make_unique<BroadPhaseCache>();
   scratch_ = std::make_unique<StepScratch>();

@@ -74,5 +74,26 @@ TEST(Pipeline, CopyWithoutCachesContinuesBitForBit) {
     ASSERT_EQ(std::memcmp(&a.bodies()[i].s, &b.bodies()[i].s, sizeof(BodyState)), 0) << i;
 }
 
+// 2,000 boxes at one point would make two million pairs: the scene is refused, naming the
+// field; 300 boxes of the pile as placed are well inside the budget.
+TEST(Pipeline, ScenePackedBeyondThePairBudgetIsRefused) {
+  Scene dense = bundled("pile");
+  dense.bodies.resize(2000, dense.bodies.front());
+  for (std::size_t i = 0; i < dense.bodies.size(); ++i) {
+    dense.bodies[i].name = "b" + std::to_string(i);
+    dense.bodies[i].position = Vec3(0.0, 5.0, 0.0);
+  }
+  try {
+    World world(dense);
+    FAIL() << "a scene of 2,000 boxes at one point was accepted";
+  } catch (const InvalidInput& e) {
+    EXPECT_NE(std::string(e.what()).find("bodies: more than 65024 pairs"), std::string::npos)
+        << e.what();
+  }
+  World pile(bundled("pile"));
+  pile.step();
+  EXPECT_EQ(pile.last_step().pair_budget_exceeded, 0u);
+}
+
 }  // namespace
 }  // namespace tumble
