@@ -25,8 +25,9 @@ class Solver {
  public:
   Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
-        block_(scratch.blocks), order_(scratch.order) {
+        rows_(scratch.rows), fixed_(scratch.fixed), order_(scratch.order) {
     index_.resize(bodies.size(), -1);
+    fixed_ = SolverBody{};
     sb_.resize(ids.size());
     for (std::size_t k = 0; k < ids.size(); ++k) {
       const Body& b = bodies[ids[k]];
@@ -79,8 +80,19 @@ class Solver {
       for (int k = 0; k < 2; ++k) p.tangent_mass[k] = 1.0 / inverse_mass(a, b, p.ra, p.rb, t[k]);
       p.pseudo_impulse = 0.0;
     }
-    if (block_.size() <= n) block_.resize(n + 1);
-    BlockInverse& block = block_[n];
+    if (rows_.size() <= n) rows_.resize(n + 1);
+    ContactRows& block = rows_[n];
+    block.dir = {c.normal, t[0], t[1]};
+    for (int i = 0; i < c.count; ++i) {
+      const ContactPoint& p = c.points[i];
+      PointRows& r = block.points[i];
+      for (int k = 0; k < 3; ++k) {
+        r.ang_a[k] = a ? Vec3(p.ra.cross(block.dir[k])) : Vec3::Zero();
+        r.inv_a[k] = a ? Vec3(a->inv_inertia * r.ang_a[k]) : Vec3::Zero();
+        r.ang_b[k] = p.rb.cross(block.dir[k]);
+        r.inv_b[k] = b->inv_inertia * r.ang_b[k];
+      }
+    }
     if (c.count == 1) {
       block.D.setZero(1, 3);
       block.D(0, 0) = 1.0;
@@ -99,9 +111,25 @@ class Solver {
   /// at j), 1/kg; a or b null: that body is held fixed.
   static NormalSystem normal_system_of(const Contact& c, const SolverBody* a,
                                        const SolverBody* b);
-  void warm_start(Contact& c);
-  void solve_velocity(Contact& c, std::size_t n, double dt);
-  void solve_position(Contact& c, const SolverSettings& s, double dt);
+  void warm_start(Contact& c, std::size_t index);
+  void solve_velocity(Contact& c, std::size_t index, double dt);
+  void solve_position(Contact& c, std::size_t index, const SolverSettings& s, double dt);
+  /// The solver body of id, or the fixed stand-in for the floor.
+  SolverBody& side(std::uint32_t id) { return id == kStaticBody ? fixed_ : sb_[index_[id]]; }
+  /// Relative velocity of b over a along row k of a point (d = dir[k]), m/s.
+  static double relative_speed(const SolverBody& a, const SolverBody& b, const Vec3& d,
+                               const PointRows& r, int k) {
+    return d.dot(b.v - a.v) + b.w.dot(r.ang_b[k]) - a.w.dot(r.ang_a[k]);
+  }
+  /// Impulse j (N·s) along row k of a point: +j d on b, −j d on a.
+  static void push(SolverBody& a, SolverBody& b, const Vec3& d, const PointRows& r, int k,
+                   double j) {
+    if (j == 0.0) return;
+    a.v -= (a.inv_mass * j) * d;
+    a.w -= j * r.inv_a[k];
+    b.v += (b.inv_mass * j) * d;
+    b.w += j * r.inv_b[k];
+  }
   /// Writes the end-of-step momenta P = m v, L = I w (I at the step start).
   void finish();
   /// Forgets the body index, so the next step starts from an index of −1 only.
@@ -117,7 +145,8 @@ class Solver {
   std::span<const std::uint32_t> ids_;
   std::vector<std::int32_t>& index_;
   std::vector<SolverBody>& sb_;
-  std::vector<BlockInverse>& block_;  // pseudo-inverse of each contact's normal matrix K
+  std::vector<ContactRows>& rows_;  // solver rows of each contact
+  SolverBody& fixed_;               // the floor: absorbs impulses without moving
   std::vector<std::pair<double, std::uint32_t>>& order_;
 };
 
@@ -164,16 +193,15 @@ int Solver::impact(Contact& c, const Vec3& gravity, double dt) {
   return 1;
 }
 
-void Solver::warm_start(Contact& c) {
-  SolverBody* a = body(c.a);
-  SolverBody* b = body(c.b);
-  Vec3 t[2];
-  tangents(c.normal, t[0], t[1]);
+void Solver::warm_start(Contact& c, std::size_t index) {
+  SolverBody& a = side(c.a);
+  SolverBody& b = side(c.b);
+  const ContactRows& rows = rows_[index];
   for (int i = 0; i < c.count; ++i) {
     const ContactPoint& p = c.points[i];
-    const Vec3 j = p.normal_impulse * c.normal + p.tangent_impulse[0] * t[0] +
-                   p.tangent_impulse[1] * t[1];
-    if (!j.isZero()) apply(a, b, p.ra, p.rb, j);
+    const std::array<double, 3> j{p.normal_impulse, p.tangent_impulse[0], p.tangent_impulse[1]};
+    if (j[0] == 0.0 && j[1] == 0.0 && j[2] == 0.0) continue;
+    for (int k = 0; k < 3; ++k) push(a, b, rows.dir[k], rows.points[i], k, j[k]);
   }
 }
 
@@ -186,17 +214,16 @@ void Solver::warm_start(Contact& c) {
 // approach by their gap within the step but no more, so a falling body stops at the surface
 // instead of penetrating first.
 void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
-  SolverBody* a = body(c.a);
-  SolverBody* b = body(c.b);
-  Vec3 t[2];
-  tangents(c.normal, t[0], t[1]);
+  SolverBody& a = side(c.a);
+  SolverBody& b = side(c.b);
+  const ContactRows& rows = rows_[index];
   for (int i = 0; i < c.count; ++i) {
     ContactPoint& p = c.points[i];
-    const Vec3 dv = point_velocity(b, p.rb) - point_velocity(a, p.ra);
+    const PointRows& r = rows.points[i];
     const double limit = c.friction * p.normal_impulse;
     const double old0 = p.tangent_impulse[0], old1 = p.tangent_impulse[1];
-    double n0 = old0 - p.tangent_mass[0] * dv.dot(t[0]);
-    double n1 = old1 - p.tangent_mass[1] * dv.dot(t[1]);
+    double n0 = old0 - p.tangent_mass[0] * relative_speed(a, b, rows.dir[1], r, 1);
+    double n1 = old1 - p.tangent_mass[1] * relative_speed(a, b, rows.dir[2], r, 2);
     const double len = std::sqrt(n0 * n0 + n1 * n1);
     if (len > limit) {
       const double scale = len > 0.0 ? limit / len : 0.0;
@@ -204,7 +231,8 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
       n1 *= scale;
     }
     p.tangent_impulse = {n0, n1};
-    apply(a, b, p.ra, p.rb, (n0 - old0) * t[0] + (n1 - old1) * t[1]);
+    push(a, b, rows.dir[1], r, 1, n0 - old0);
+    push(a, b, rows.dir[2], r, 2, n1 - old1);
   }
   // Block solve of the contact's normal impulses: all points at once through the
   // pseudo-inverse of K (Box2D's two-point block solver, generalised with the pseudo-inverse
@@ -212,18 +240,16 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
   // Point-by-point Gauss–Seidel leaves such a patch rocking; the block step removes it. When
   // the block answer would pull at a point, the points fall back to one clamped sweep.
   const int n = c.count;
-  const BlockInverse& block = block_[index];
   std::array<double, kMaxContactPoints> next{};
   Vec3 projected = Vec3::Zero();  // Dᵀ rhs
   for (int i = 0; i < n; ++i) {
-    const ContactPoint& p = c.points[i];
-    const double vn = (point_velocity(b, p.rb) - point_velocity(a, p.ra)).dot(c.normal);
-    projected += (target_of(p, dt) - vn) * block.D.row(i).transpose();
+    const double vn = relative_speed(a, b, rows.dir[0], rows.points[i], 0);
+    projected += (target_of(c.points[i], dt) - vn) * rows.D.row(i).transpose();
   }
-  const Vec3 z = block.P * projected;
+  const Vec3 z = rows.P * projected;
   bool pushes = true;
   for (int i = 0; i < n; ++i) {
-    next[i] = c.points[i].normal_impulse + block.D.row(i).dot(z);
+    next[i] = c.points[i].normal_impulse + rows.D.row(i).dot(z);
     pushes = pushes && next[i] >= 0.0;
   }
   if (pushes) {
@@ -231,18 +257,17 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
       ContactPoint& p = c.points[i];
       const double delta = next[i] - p.normal_impulse;
       p.normal_impulse = next[i];
-      if (delta != 0.0) apply(a, b, p.ra, p.rb, delta * c.normal);
+      push(a, b, rows.dir[0], rows.points[i], 0, delta);
     }
     return;
   }
   for (int i = 0; i < n; ++i) {
     ContactPoint& p = c.points[i];
-    const double vn = (point_velocity(b, p.rb) - point_velocity(a, p.ra)).dot(c.normal);
-    const double target = target_of(p, dt);
-    const double next_i = std::max(0.0, p.normal_impulse - p.normal_mass * (vn - target));
+    const double vn = relative_speed(a, b, rows.dir[0], rows.points[i], 0);
+    const double next_i = std::max(0.0, p.normal_impulse - p.normal_mass * (vn - target_of(p, dt)));
     const double delta = next_i - p.normal_impulse;
     p.normal_impulse = next_i;
-    if (delta != 0.0) apply(a, b, p.ra, p.rb, delta * c.normal);
+    push(a, b, rows.dir[0], rows.points[i], 0, delta);
   }
 }
 
@@ -315,21 +340,28 @@ NormalSystem Solver::normal_system_of(const Contact& c, const SolverBody* a,
 // Split impulse (Catto, GDC 2006 notes; Bullet's splitImpulse): penetration beyond the slop is
 // removed by pseudo velocities that move the positions but never enter the momenta, so the
 // correction adds no energy (Baumgarte's bias would make stacks bounce).
-void Solver::solve_position(Contact& c, const SolverSettings& s, double dt) {
-  SolverBody* a = body(c.a);
-  SolverBody* b = body(c.b);
+void Solver::solve_position(Contact& c, std::size_t index, const SolverSettings& s, double dt) {
+  SolverBody& a = side(c.a);
+  SolverBody& b = side(c.b);
+  const ContactRows& rows = rows_[index];
+  const Vec3& n = rows.dir[0];
   for (int i = 0; i < c.count; ++i) {
     ContactPoint& p = c.points[i];
+    const PointRows& r = rows.points[i];
     // Pseudo velocities obey the contacts too: a touching point may not be pushed deeper by
     // the correction of another contact (a box pressed into the floor by the one above it).
     const double target = p.separation > 0.0
                               ? -p.separation / dt
                               : s.position_gain * std::max(-p.separation - s.slop, 0.0) / dt;
-    const double vn = (pseudo_velocity(b, p.rb) - pseudo_velocity(a, p.ra)).dot(c.normal);
+    const double vn = n.dot(b.vp - a.vp) + b.wp.dot(r.ang_b[0]) - a.wp.dot(r.ang_a[0]);
     const double next = std::max(0.0, p.pseudo_impulse + p.normal_mass * (target - vn));
     const double delta = next - p.pseudo_impulse;
     p.pseudo_impulse = next;
-    if (delta != 0.0) apply_pseudo(a, b, p.ra, p.rb, delta * c.normal);
+    if (delta == 0.0) continue;
+    a.vp -= (a.inv_mass * delta) * n;
+    a.wp -= delta * r.inv_a[0];
+    b.vp += (b.inv_mass * delta) * n;
+    b.wp += delta * r.inv_b[0];
   }
 }
 
@@ -418,12 +450,13 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   for (std::size_t i = 0; i < contacts.size(); ++i) solver.prepare(contacts[i], i);
   int impacts = 0;
   for (Contact& c : contacts) impacts += solver.impact(c, gravity, dt);
-  for (Contact& c : contacts) solver.warm_start(c);
+  for (std::size_t i = 0; i < contacts.size(); ++i) solver.warm_start(contacts[i], i);
   for (int it = 0; it < settings.velocity_iterations; ++it)
     for (std::size_t i = 0; i < contacts.size(); ++i) solver.solve_velocity(contacts[i], i, dt);
   if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt);
   for (int it = 0; it < settings.position_iterations; ++it)
-    for (Contact& c : contacts) solver.solve_position(c, settings, dt);
+    for (std::size_t i = 0; i < contacts.size(); ++i)
+      solver.solve_position(contacts[i], i, settings, dt);
   solver.finish();
   solver.release();
   return impacts;

@@ -74,18 +74,31 @@ struct SolverBody {
   double inv_mass = 0.0;            ///< 1/kg.
 };
 
-/// K⁺ = D P Dᵀ of one contact's normal-impulse matrix (active_set.hpp), kept factored: a
-/// product with it costs 6m + 9 multiplications instead of m².
-struct BlockInverse {
-  PlaneCoordinates D;     ///< (1, α, β) of each point.
-  Mat3 P = Mat3::Zero();  ///< The 3×3 middle factor.
+/// One contact point's rows along the normal and the two tangents (k = 0, 1, 2), computed
+/// once a step so that the iterations are dot products and axpys (Box2D's contact solver).
+struct PointRows {
+  std::array<Vec3, 3> ang_a;  ///< ra × d_k, m (zero for the floor).
+  std::array<Vec3, 3> ang_b;  ///< rb × d_k, m.
+  std::array<Vec3, 3> inv_a;  ///< I_a⁻¹ (ra × d_k), 1/(kg·m).
+  std::array<Vec3, 3> inv_b;  ///< I_b⁻¹ (rb × d_k), 1/(kg·m).
+};
+
+/// A contact's solver data: its directions, its points' rows and K⁺ = D P Dᵀ of its
+/// normal-impulse matrix (active_set.hpp), kept factored: a product with it costs 6m + 9
+/// multiplications instead of m².
+struct ContactRows {
+  std::array<Vec3, 3> dir;  ///< n, t1, t2 (unit, world).
+  PlaneCoordinates D;       ///< (1, α, β) of each point.
+  Mat3 P = Mat3::Zero();    ///< The 3×3 middle factor.
+  std::array<PointRows, kMaxContactPoints> points;  ///< Rows of each point.
 };
 
 /// The solver's buffers, reused between steps.
 struct SolverScratch {
   std::vector<SolverBody> bodies;     ///< One per solver body, in the order given.
   std::vector<std::int32_t> index;    ///< Body id → position in `bodies`, −1 when absent.
-  std::vector<BlockInverse> blocks;   ///< Pseudo-inverse of each contact's normal matrix K.
+  std::vector<ContactRows> rows;      ///< Solver rows of each contact.
+  SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
   std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
 };
 
