@@ -122,7 +122,10 @@ std::string dt_label(double dt) {
   return fmt(dt);
 }
 
-Csv::Csv(const fs::path& path, std::initializer_list<std::string> columns) : f_(path) {
+Csv::Csv(const fs::path& path, std::initializer_list<std::string> columns)
+    : Csv(path, std::vector<std::string>(columns)) {}
+
+Csv::Csv(const fs::path& path, const std::vector<std::string>& columns) : f_(path) {
   f_.precision(17);
   bool first = true;
   for (const std::string& c : columns) {

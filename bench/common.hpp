@@ -71,6 +71,8 @@ std::string dt_label(double dt);
 class Csv {
  public:
   Csv(const fs::path& path, std::initializer_list<std::string> columns);
+  /// Same, with columns known only at run time.
+  Csv(const fs::path& path, const std::vector<std::string>& columns);
   /// Starts a new row.
   Csv& row();
   /// Appends one cell to the current row.

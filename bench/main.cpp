@@ -79,11 +79,13 @@ int main(int argc, char** argv) {
       {"skip", run_skip},
       {"peers", run_peers},
       {"contact", run_contact},
+      {"stages", run_stages},
   };
   Options o;
   std::string command, out, docs;
   po::options_description visible(
-      "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact> [options]\n"
+      "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact|stages> "
+      "[options]\n"
       "Options");
   visible.add_options()("help,h", "this help")(
       "quick", po::bool_switch(&o.quick), "short version of everything (< 60 s), for ctest")(
@@ -132,7 +134,7 @@ int main(int argc, char** argv) {
 
   const double start = wall_seconds();
   const std::vector<std::string> order = {"work-precision", "stability", "throughput", "skip",
-                                          "peers", "contact"};
+                                          "peers", "contact", "stages"};
   int failures = 0;
   for (const std::string& name : order) {
     if (command != "all" && command != name) continue;
