@@ -77,7 +77,8 @@ double deepest_penetration(const PeerWorld& w, const tumble::Scene& s);
 
 /// One row of the table, derived from a SceneResult (shared by the CSV and the Markdown).
 struct Row {
-  std::string scene, engine;
+  std::string scene;          ///< Scene name.
+  std::string engine;         ///< Engine name.
   double ms = NAN;            ///< Median ms per step (NaN unless valid, Tumble always).
   double ratio = NAN;         ///< Peer time / Tumble time (1 for Tumble).
   double tower_drift = NAN;   ///< m, tower only.

@@ -12,8 +12,8 @@
 
 namespace tumble_bench {
 
-using Vec3 = Eigen::Vector3d;
-using Quat = Eigen::Quaterniond;
+using Vec3 = Eigen::Vector3d;     ///< Vectors in the world frame.
+using Quat = Eigen::Quaterniond;  ///< Orientations, body → world.
 
 /// One box as a peer sees it (SI units, angular velocity in the world frame).
 struct PeerBox {
@@ -50,7 +50,7 @@ struct PeerBodyState {
 /// A live peer world.
 class PeerWorld {
  public:
-  virtual ~PeerWorld() = default;
+  virtual ~PeerWorld() = default;  ///< Frees the peer's world.
   /// Advances by the scene's dt.
   virtual void step() = 0;
   /// State of body i.

@@ -20,7 +20,7 @@ namespace tumble_bench::peers {
 
 /// One engine at one dt on the `tumble` scene.
 struct TumbleRun {
-  std::string engine;
+  std::string engine;  ///< Engine name.
   double dt = NAN;   ///< s.
   double cpu = NAN;  ///< CPU s of the whole 20 s run.
   double err = NAN;  ///< Geodesic orientation error at 20 s against the reference, rad.
@@ -28,7 +28,7 @@ struct TumbleRun {
 
 /// The first three apexes of `bounce` on one engine.
 struct BounceRun {
-  std::string engine;
+  std::string engine;                ///< Engine name.
   double apex[3] = {NAN, NAN, NAN};  ///< m (lowest point of the cube).
   double err = NAN;                  ///< |apex 1 − e²h₀|, m.
 };
@@ -63,8 +63,8 @@ Measurement measure(const Options& o);
 
 /// One engine's landing at one N, medians, with its ratio to Tumble.
 struct LandingRow {
-  std::string engine;
-  std::size_t n = 0;
+  std::string engine;                          ///< Engine name.
+  std::size_t n = 0;                           ///< Cubes.
   double ns = NAN, ns_head = NAN;              ///< ns per body-step: whole run, first part.
   double ratio = NAN, ratio_head = NAN;        ///< Peer time / Tumble time (1 for Tumble).
   double impacts_per_box = NAN;                ///< NaN: the engine has no counter.
@@ -79,7 +79,12 @@ std::vector<LandingRow> landing_rows(const Measurement& m);
 
 /// Files written by record().
 struct Files {
-  fs::path tumble_csv, tumble_svg, bounce_csv, throughput_csv, throughput_svg, landing_csv;
+  fs::path tumble_csv;      ///< peers_tumble.csv.
+  fs::path tumble_svg;      ///< Its plot.
+  fs::path bounce_csv;      ///< peers_bounce.csv.
+  fs::path throughput_csv;  ///< peers_throughput.csv (skip is in the Markdown only).
+  fs::path throughput_svg;  ///< Its plot.
+  fs::path landing_csv;     ///< peers_landing.csv.
 };
 
 /// Writes the CSV files, the headline values and the plots.

@@ -62,8 +62,8 @@ Measurement measure(const Options& o);
 
 /// Medians of one (shape, N) cell of the scaling sweep.
 struct ScalingRow {
-  BoxShape shape;
-  std::size_t n = 0;
+  BoxShape shape;            ///< Cube or general box.
+  std::size_t n = 0;         ///< Bodies.
   bool full = true;          ///< The whole run was timed (N < n_big), not only its head.
   long steps = 0;            ///< Steps per run.
   std::size_t runs = 0;      ///< Runs taken.
@@ -78,8 +78,8 @@ std::vector<ScalingRow> scaling_rows(const Measurement& m);
 
 /// Medians of the landing runs at one N.
 struct LandingRow {
-  std::size_t n = 0;
-  std::size_t runs = 0;
+  std::size_t n = 0;                    ///< Cubes.
+  std::size_t runs = 0;                 ///< Runs taken.
   double ns = NAN, ns_head = NAN;       ///< ns per body-step: whole run, first head.
   double impacts_per_box = NAN;         ///< Over the timed run.
   double asleep_fraction = NAN;         ///< At the end of the timed run.
@@ -93,7 +93,9 @@ std::vector<LandingRow> landing_rows(const Measurement& m);
 
 /// Files written by record().
 struct Files {
-  fs::path csv, landing_csv, svg;
+  fs::path csv;          ///< throughput.csv (scaling and integrators).
+  fs::path landing_csv;  ///< throughput_landing.csv.
+  fs::path svg;          ///< The scaling plot.
 };
 
 /// Writes throughput.csv, throughput_landing.csv, the headline values and the plot.
