@@ -89,6 +89,17 @@ bool reset_peak_resident() {
   return static_cast<bool>(f);
 }
 
+bool selected(const Options& o, const std::string& name) {
+  return o.only.empty() || std::find(o.only.begin(), o.only.end(), name) != o.only.end();
+}
+
+std::string partial_note(const Options& o) {
+  if (o.only.empty()) return "";
+  std::string s;
+  for (const std::string& n : o.only) s += (s.empty() ? "`" : ", `") + n + "`";
+  return ", a partial run with `--only` (" + s + " only)";
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());

@@ -21,6 +21,9 @@ struct Options {
   fs::path docs;       ///< Markdown file assembled from the sections.
   bool plots = true;   ///< Run gnuplot.
   int repeats = 3;     ///< Interleaved repetitions for timings (median taken).
+  /// `contact` and `stages`: run only these scenes (empty: all), e.g. {"pyramid_large"}. The
+  /// section then says it is a partial run.
+  std::vector<std::string> only;
 };
 
 /// A progress bar on stderr: "label [#####.....]  45%  9/20  3.1 s". Redraws at most 10×/s on
@@ -59,6 +62,11 @@ std::uint64_t resident_bytes();
 std::uint64_t peak_resident_bytes();
 /// Resets VmHWM (writes 5 to /proc/self/clear_refs); false if the kernel refused.
 bool reset_peak_resident();
+
+/// True when `name` is selected by o.only (always, when o.only is empty).
+bool selected(const Options& o, const std::string& name);
+/// " (only `a`, `b`)" for a partial run, "" for a full one: for section headers.
+std::string partial_note(const Options& o);
 
 /// Median of a non-empty list.
 double median(std::vector<double> v);

@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
       {"stages", run_stages},
   };
   Options o;
-  std::string command, out, docs;
+  std::string command, out, docs, only;
   po::options_description visible(
       "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact|stages> "
       "[options]\n"
@@ -94,7 +94,9 @@ int main(int argc, char** argv) {
       "docs", po::value(&docs)->default_value(std::string(TUMBLE_BENCH_SOURCE_DIR) + "/docs/benchmarks.md"),
       "Markdown page assembled from the results")(
       "no-plots", "skip gnuplot")("repeats", po::value(&o.repeats)->default_value(3),
-                                 "interleaved repetitions of each timing (median)");
+                                 "interleaved repetitions of each timing (median)")(
+      "only", po::value(&only),
+      "contact, stages: only these scenes, comma-separated (e.g. pyramid_large)");
   po::options_description hidden;
   hidden.add_options()("command", po::value(&command));
   po::options_description all;
@@ -117,10 +119,16 @@ int main(int argc, char** argv) {
   o.docs = docs;
   o.plots = !vm.count("no-plots");
   if (o.quick) o.repeats = std::min(o.repeats, 1);
+  for (std::size_t a = 0; !only.empty() && a <= only.size();) {
+    const std::size_t b = std::min(only.find(',', a), only.size());
+    if (b > a) o.only.push_back(only.substr(a, b - a));
+    a = b + 1;
+  }
   fs::create_directories(o.out);
 
   std::ostringstream cmdline;
-  cmdline << "tumble-bench " << command << (o.quick ? " --quick" : "");
+  cmdline << "tumble-bench " << command << (o.quick ? " --quick" : "")
+          << (only.empty() ? "" : " --only " + only);
   if (vm["out"].defaulted() && vm["docs"].defaulted()) {
     cmdline.str("");
     cmdline << "cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release "

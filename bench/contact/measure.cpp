@@ -3,6 +3,7 @@
 /// engine. Returns plain structs; writes nothing.
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "contact/contact.hpp"
 #include "scenes.hpp"
@@ -159,7 +160,11 @@ Measurement measure(const Options& o) {
   m.engines = contenders();
   m.reps = o.quick ? 1 : std::max(3, o.repeats);
   m.tower_steps = tower_awake_steps(o.quick);
-  const std::vector<SceneSpec> specs = scene_specs(o.quick);
+  std::vector<SceneSpec> specs;
+  for (const SceneSpec& s : scene_specs(o.quick))
+    if (selected(o, s.name)) specs.push_back(s);
+  if (specs.empty())
+    throw std::runtime_error("--only names none of tower, pyramid, pile, pyramid_large");
   Progress bar("contact", specs.size() * (static_cast<std::size_t>(m.reps) + 1));
   for (const SceneSpec& spec : specs) m.scenes.push_back(measure_scene(m, spec, bar));
   return m;

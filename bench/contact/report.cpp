@@ -51,6 +51,7 @@ void report(const Options& o, const Measurement& m, const fs::path& svg) {
       {"date", v.count("date") ? v.at("date") : "unknown"},
       {"engine_commit", v.count("engine_commit") ? v.at("engine_commit") : "unknown"},
       {"quick", o.quick ? " --quick" : ""},
+      {"partial", partial_note(o)},
       {"reps", std::to_string(m.reps)},
       {"peer_awake_notes", awake_notes.empty() ? "no peers built in" : awake_notes},
       {"timed_steps", joined(m, [](const SceneResult& r) {

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <stdexcept>
 
 #include "scenes.hpp"
 #include "stages/stages.hpp"
@@ -79,7 +80,11 @@ SceneStages summarize(const Spec& spec, std::size_t bodies, const std::vector<To
 Measurement measure(const Options& o) {
   Measurement m;
   m.reps = o.quick ? 1 : std::max(3, o.repeats);
-  const std::vector<Spec> all = specs(o.quick);
+  std::vector<Spec> all;
+  for (const Spec& s : specs(o.quick))
+    if (selected(o, s.label.substr(0, s.label.find(' ')))) all.push_back(s);
+  if (all.empty())
+    throw std::runtime_error("--only names none of tower, pyramid, pile, throughput, landing");
   std::vector<tumble::Scene> scenes;
   for (const Spec& s : all) scenes.push_back(s.build());
   std::vector<std::vector<Totals>> runs(all.size());

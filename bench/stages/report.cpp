@@ -60,6 +60,7 @@ void report(const Options& o, const Measurement& m, const fs::path& csv) {
       {"date", v.count("date") ? v.at("date") : "unknown"},
       {"engine_commit", v.count("engine_commit") ? v.at("engine_commit") : "unknown"},
       {"quick", o.quick ? " --quick" : ""},
+      {"partial", partial_note(o)},
       {"reps", std::to_string(m.reps)},
       {"csv", file_link(o, csv)},
       {"scenes_table", scenes_table(m)},
