@@ -37,6 +37,36 @@ std::string verdict(double value, double goal, bool lower_is_better = true) {
   return met ? "**met**" : "**not met**";
 }
 
+/// The landing, the large pyramid and the stage breakdown (issue 11's list), from the
+/// values the `throughput`, `peers`, `contact` and `stages` sections recorded.
+std::string closing_note_contact(const std::map<std::string, std::string>& v) {
+  std::ostringstream s;
+  const std::string t = "throughput.landing.N10000.";
+  s << "- **Landing, N = 10,000 unit cubes, μ = 1, e = 0** (`throughput` section): "
+    << fmt(number(v, t + "ns_per_body_step")) << " ns per body-step over 2 s ("
+    << fmt(number(v, t + "ns_per_body_step_first_0.5s")) << " ns over the first 0.5 s), "
+    << fmt(number(v, t + "impacts_per_box")) << " impacts per box, "
+    << fixed(100.0 * number(v, t + "asleep_fraction"), 0) << " % asleep at 2 s, all asleep at "
+    << fmt(number(v, t + "all_asleep_s")) << " s.";
+  const double bullet = number(v, "peers.landing.N10000.bullet.ratio_peer_over_tumble");
+  s << " Bullet's time / Tumble's in the `peers` run: " << fmt(bullet)
+    << "×, goal ≥ 2×: " << verdict(bullet, 2.0, false) << ".\n";
+  const std::string p = "contact.pyramid_large.";
+  s << "- **`pyramid_large`** (5,050 cubes, `contact` section): top box moved "
+    << fmt(number(v, p + "tumble_top_moved_m")) << " m, stands (≤ 5 cm): "
+    << text(v, p + "tumble_stands") << "; asleep at " << fmt(number(v, p + "tumble_asleep_s"))
+    << " s; " << fmt(number(v, p + "tumble_ms")) << " ms per step awake, fastest peer "
+    << text(v, p + "fastest_peer") << " at " << fmt(number(v, p + "ratio_to_fastest"))
+    << "× Tumble's time.\n";
+  s << "- **Per-stage breakdown** (`stages` section): "
+    << (text(v, "stages.available") == "yes" ? "measured"
+        : text(v, "stages.available") == "no"
+            ? "stage timings not available in this engine build"
+            : "not measured")
+    << ".\n";
+  return s.str();
+}
+
 std::string closing_note(const Options& o, const std::map<std::string, std::string>& v) {
   std::ostringstream s;
   s << "## Closing note\n\n";
@@ -98,6 +128,7 @@ std::string closing_note(const Options& o, const std::map<std::string, std::stri
   const double apex = number(v, "wp.bounce_apex1_err.exact.root");
   s << "- **First bounce apex** (`exact` + `root`, worst over every dt): " << fmt(apex)
     << " m, goal ≤ 1e-9 m: " << verdict(apex, 1e-9) << ".\n";
+  s << closing_note_contact(v);
   const fs::path table = o.out / "stability_table.md";
   if (fs::exists(table)) {
     s << "- **Stability** (the table from the `stability` section):\n\n" << read_all(table)
