@@ -32,11 +32,15 @@ std::vector<SceneSpec> scene_specs(bool quick);
 /// Steps of the tower's kept-awake drift run (60 s at dt = 1/60; fewer with --quick).
 long tower_awake_steps(bool quick);
 
+/// Top box of a stack may move at most this far over the run to count as standing, m.
+inline constexpr double kStandsTolerance = 0.05;
+
 /// What an untimed run saw.
 struct Behaviour {
   double penetration = NAN;  ///< Deepest overlap seen, m.
   double drift = NAN;        ///< Largest |x − x₀| over the bodies at the end, m.
   double top_moved = NAN;    ///< Largest |x − x₀| of the top box over the run, m (stacks).
+  double top_left_at = NAN;  ///< Sim time the top box first moved > kStandsTolerance, s.
   double end_time = NAN;     ///< Sim time at the end of the run, s.
   double asleep_at = NAN;    ///< Sim time when every body first slept (NaN: never/no sleeping).
   std::string trouble;       ///< What went wrong in the engine, empty when nothing did.
@@ -84,14 +88,12 @@ struct Row {
   double tower_drift = NAN;   ///< m, tower only.
   double penetration = NAN;   ///< m.
   double top_moved = NAN;     ///< m, stacks only.
-  std::string stands;         ///< "yes", "no", or "–" (not a stack / not run).
+  std::string stands;         ///< "yes", "no (from t s)", or "–" (not a stack / not run).
   std::string asleep;         ///< "0.8 s", "> 10 s", "no sleeping", "–".
   std::string note;           ///< Refusal or trouble, else the short-timing note.
   bool valid = false;         ///< Ran and nothing went wrong.
 };
 
-/// Top box of a stack may move at most this far over the run to count as standing, m.
-inline constexpr double kStandsTolerance = 0.05;
 
 /// The table rows of one scene, engines in order.
 std::vector<Row> rows(const Measurement& m, const SceneResult& r);

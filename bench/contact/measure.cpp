@@ -68,6 +68,8 @@ Behaviour observe(const Contender& c, const tumble::Scene& s, long steps, bool a
     if (awake) e->keep_awake(i);
     e->step();
     top_moved = std::max(top_moved, (e->state(top).position - x0[top]).norm());
+    if (top_moved > kStandsTolerance && !std::isfinite(r.top_left_at))
+      r.top_left_at = static_cast<double>(i) * s.world.dt;
     if (i % every == 0) deepest = std::max(deepest, deepest_penetration(*e, s));
     if (!awake && e->awake_count() == 0) {
       r.asleep_at = static_cast<double>(i) * s.world.dt;

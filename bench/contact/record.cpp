@@ -70,7 +70,8 @@ fs::path record(const Options& o, const Measurement& m) {
     Csv out(o.out / "contact.csv",
             {"scene", "scene_index", "engine", "engine_index", "bodies", "timed_steps",
              "ms_per_step", "ratio_peer_over_tumble", "tower_drift_60s_m", "max_penetration_m",
-             "asleep_at_s", "sleeping_run_end_s", "note", "top_box_moved_m", "stands"});
+             "asleep_at_s", "sleeping_run_end_s", "note", "top_box_moved_m", "stands",
+             "top_box_left_at_s"});
     for (std::size_t si = 0; si < m.scenes.size(); ++si) {
       const SceneResult& r = m.scenes[si];
       const std::vector<Row> rs = rows(m, r);
@@ -79,7 +80,7 @@ fs::path record(const Options& o, const Measurement& m) {
         const Behaviour& b = r.engine.at(row.engine).sleeping;
         out.row() << r.spec.name << si << row.engine << ei << r.bodies << r.timed_steps << row.ms
                   << row.ratio << row.tower_drift << row.penetration << b.asleep_at << b.end_time
-                  << row.note << row.top_moved << row.stands;
+                  << row.note << row.top_moved << row.stands << b.top_left_at;
         print(row);
       }
       record_scene(o, r, rs);

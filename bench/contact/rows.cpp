@@ -51,9 +51,10 @@ std::vector<Row> rows(const Measurement& m, const SceneResult& r) {
     row.stands = !r.spec.stack || !std::isfinite(row.top_moved) ? "–"
                  : row.top_moved <= kStandsTolerance             ? "yes"
                                                                  : "no";
+    if (row.stands == "no") row.stands += " (from " + fmt(e.sleeping.top_left_at) + " s)";
     // A run cut short by its CPU budget only vouches for the time it covered.
     const double cap_s = static_cast<double>(r.spec.sleep_cap) * r.dt;
-    if (row.stands != "–" && !std::isfinite(e.sleeping.asleep_at) &&
+    if (row.stands == "yes" && !std::isfinite(e.sleeping.asleep_at) &&
         e.sleeping.end_time < cap_s - 1e-9)
       row.stands += " (first " + fmt(e.sleeping.end_time) + " s)";
     row.asleep = sleep_text(c, e.sleeping);
