@@ -28,6 +28,10 @@ Plan plan(bool quick) {
   return {480, 120, 480};
 }
 
+double watched_until(const Plan& p, double dt) {
+  return static_cast<double>(p.steps + p.settle_steps) * dt;
+}
+
 std::vector<std::size_t> sizes(bool quick) {
   return quick ? std::vector<std::size_t>{100, 1000} : std::vector<std::size_t>{1000, 10000};
 }

@@ -19,6 +19,9 @@ struct Plan {
                             ///< moment every box is asleep (0: don't look past the run).
 };
 
+/// Sim time a run covers at most, timed and settling, s (dt: the scene's step).
+double watched_until(const Plan& p, double dt);
+
 /// The plan for a full run (2 s, first 0.5 s, settle up to 4 s) or for --quick.
 Plan plan(bool quick);
 /// Sizes N measured (1,000 and 10,000; smaller with --quick).

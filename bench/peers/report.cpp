@@ -107,7 +107,6 @@ std::string landing_notes(const Measurement& m) {
 
 void report(const Options& o, const Measurement& m, const Files& files) {
   const double e = m.bounce_e, h0 = m.bounce_h0;
-  const double watched = landing_rows(m).empty() ? NAN : landing_rows(m).front().watched_until;
   const Fields f{
       {"settings", settings()},
       {"tumble_plot", image_link(o, files.tumble_svg, "tumble: peers work-precision")},
@@ -133,7 +132,7 @@ void report(const Options& o, const Measurement& m, const Files& files) {
       {"not_run", not_run(m)},
       {"landing_duration", fmt(static_cast<double>(m.landing_plan.steps) / 240.0)},
       {"landing_head", fmt(static_cast<double>(m.landing_plan.head_steps) / 240.0)},
-      {"landing_watched", fmt(watched)},
+      {"landing_watched", fmt(landing::watched_until(m.landing_plan, 1.0 / 240.0))},
       {"landing_csv", file_link(o, files.landing_csv)},
       {"landing_table", landing_table(m) + landing_notes(m)},
   };

@@ -70,7 +70,6 @@ void report(const Options& o, const Measurement& m, const Files& files) {
   const Config& c = m.cfg;
   const bool big = std::any_of(c.sizes.begin(), c.sizes.end(),
                                [&](std::size_t n) { return n >= c.n_big; });
-  const double watched = landing_rows(m).empty() ? NAN : landing_rows(m).front().watched_until;
   const Fields f{
       {"duration", fmt(c.duration)},
       {"steps", std::to_string(c.steps)},
@@ -88,7 +87,7 @@ void report(const Options& o, const Measurement& m, const Files& files) {
       {"integrator_table", integrator_table(m)},
       {"landing_duration", fmt(static_cast<double>(c.landing.steps) * kDt)},
       {"landing_steps", std::to_string(c.landing.steps)},
-      {"watched_until", fmt(watched)},
+      {"watched_until", fmt(landing::watched_until(c.landing, kDt))},
       {"landing_csv", file_link(o, files.landing_csv)},
       {"landing_table", landing_table(m)},
       {"landing_notes", landing_notes(m)},
