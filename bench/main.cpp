@@ -1,7 +1,8 @@
 /// tumble-bench: every benchmark figure of docs/benchmarks.md from one command.
-///   tumble-bench all                 # everything (≈ 15 min), writes bench/results and docs
+///   tumble-bench all                 # everything (≈ 25 min, estimated), writes results and docs
 ///   tumble-bench all --quick         # short version (< 60 s), used by ctest
 ///   tumble-bench work-precision      # one question only; the docs are re-assembled
+///   tumble-bench contact --only pyramid_large   # one scene of contact (or stages)
 #include <boost/program_options.hpp>
 
 #include <cstdio>
