@@ -1,5 +1,5 @@
 #pragma once
-/// The six questions tumble-bench answers; each writes CSV, plots and its docs section into
+/// The seven questions tumble-bench answers; each writes CSV, plots and its docs section into
 /// Options::out. Single-threaded.
 #include "common.hpp"
 
@@ -18,5 +18,7 @@ void run_skip(const Options& o);
 void run_peers(const Options& o);
 /// Box–box contact and stacking (tower, pyramid, pile) on Tumble and the peers, interleaved.
 void run_contact(const Options& o);
+/// Where the time of a step goes, per engine stage (tower, pyramid, pile, throughput, landing).
+void run_stages(const Options& o);
 
 }  // namespace tumble_bench

@@ -89,6 +89,17 @@ bool reset_peak_resident() {
   return static_cast<bool>(f);
 }
 
+bool selected(const Options& o, const std::string& name) {
+  return o.only.empty() || std::find(o.only.begin(), o.only.end(), name) != o.only.end();
+}
+
+std::string partial_note(const Options& o) {
+  if (o.only.empty()) return "";
+  std::string s;
+  for (const std::string& n : o.only) s += (s.empty() ? "`" : ", `") + n + "`";
+  return ", a partial run with `--only` (" + s + " only)";
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());
@@ -122,7 +133,10 @@ std::string dt_label(double dt) {
   return fmt(dt);
 }
 
-Csv::Csv(const fs::path& path, std::initializer_list<std::string> columns) : f_(path) {
+Csv::Csv(const fs::path& path, std::initializer_list<std::string> columns)
+    : Csv(path, std::vector<std::string>(columns)) {}
+
+Csv::Csv(const fs::path& path, const std::vector<std::string>& columns) : f_(path) {
   f_.precision(17);
   bool first = true;
   for (const std::string& c : columns) {

@@ -11,6 +11,7 @@
 
 namespace tumble_bench {
 
+/// Short name for std::filesystem.
 namespace fs = std::filesystem;
 
 /// Command-line options shared by every subcommand.
@@ -20,16 +21,21 @@ struct Options {
   fs::path docs;       ///< Markdown file assembled from the sections.
   bool plots = true;   ///< Run gnuplot.
   int repeats = 3;     ///< Interleaved repetitions for timings (median taken).
+  /// `contact` and `stages`: run only these scenes (empty: all), e.g. {"pyramid_large"}. The
+  /// section then says it is a partial run.
+  std::vector<std::string> only;
 };
 
 /// A progress bar on stderr: "label [#####.....]  45%  9/20  3.1 s". Redraws at most 10×/s on
 /// a terminal; into a file, one line every 10 s at most.
 class Progress {
  public:
+  /// Draws an empty bar for `total` units of work.
   Progress(std::string label, std::size_t total);
+  /// Draws the full bar and ends its line.
   ~Progress();
-  Progress(const Progress&) = delete;
-  Progress& operator=(const Progress&) = delete;
+  Progress(const Progress&) = delete;             ///< One bar per stderr line.
+  Progress& operator=(const Progress&) = delete;  ///< One bar per stderr line.
   /// Marks n more units done.
   void tick(std::size_t n = 1);
   /// Changes the note printed after the bar ("dt = 1/240").
@@ -57,6 +63,11 @@ std::uint64_t peak_resident_bytes();
 /// Resets VmHWM (writes 5 to /proc/self/clear_refs); false if the kernel refused.
 bool reset_peak_resident();
 
+/// True when `name` is selected by o.only (always, when o.only is empty).
+bool selected(const Options& o, const std::string& name);
+/// " (only `a`, `b`)" for a partial run, "" for a full one: for section headers.
+std::string partial_note(const Options& o);
+
 /// Median of a non-empty list.
 double median(std::vector<double> v);
 
@@ -70,17 +81,21 @@ std::string dt_label(double dt);
 /// A CSV file with a header line; values written with 17 significant digits.
 class Csv {
  public:
+  /// Opens `path` and writes the header line.
   Csv(const fs::path& path, std::initializer_list<std::string> columns);
+  /// Same, with columns known only at run time.
+  Csv(const fs::path& path, const std::vector<std::string>& columns);
   /// Starts a new row.
   Csv& row();
   /// Appends one cell to the current row.
   Csv& operator<<(const std::string& cell);
-  Csv& operator<<(const char* cell);
-  Csv& operator<<(double v);
-  Csv& operator<<(long long v);
+  Csv& operator<<(const char* cell);  ///< A text cell.
+  Csv& operator<<(double v);          ///< 17 significant digits; "nan", "inf".
+  Csv& operator<<(long long v);       ///< An integer cell.
   Csv& operator<<(int v) { return *this << static_cast<long long>(v); }
   Csv& operator<<(long v) { return *this << static_cast<long long>(v); }
   Csv& operator<<(std::size_t v) { return *this << static_cast<long long>(v); }
+  /// Ends the last line.
   ~Csv();
 
  private:

@@ -1,7 +1,8 @@
 /// tumble-bench: every benchmark figure of docs/benchmarks.md from one command.
-///   tumble-bench all                 # everything (≈ 15 min), writes bench/results and docs
+///   tumble-bench all                 # everything (≈ 25 min, estimated), writes results and docs
 ///   tumble-bench all --quick         # short version (< 60 s), used by ctest
 ///   tumble-bench work-precision      # one question only; the docs are re-assembled
+///   tumble-bench contact --only pyramid_large   # one scene of contact (or stages)
 #include <boost/program_options.hpp>
 
 #include <cstdio>
@@ -11,6 +12,7 @@
 #include <functional>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <sys/utsname.h>
 #include <thread>
@@ -71,32 +73,62 @@ std::string today() {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  const std::map<std::string, std::function<void(const Options&)>> commands{
-      {"work-precision", run_work_precision},
-      {"stability", run_stability},
-      {"throughput", run_throughput},
-      {"skip", run_skip},
-      {"peers", run_peers},
-      {"contact", run_contact},
-  };
+namespace {
+
+/// The subcommands in the order `all` runs them.
+const std::vector<std::pair<std::string, std::function<void(const Options&)>>> kCommands{
+    {"work-precision", run_work_precision},
+    {"stability", run_stability},
+    {"throughput", run_throughput},
+    {"skip", run_skip},
+    {"peers", run_peers},
+    {"contact", run_contact},
+    {"stages", run_stages},
+};
+
+bool known(const std::string& command) {
+  if (command == "all") return true;
+  for (const auto& [name, run] : kCommands)
+    if (name == command) return true;
+  return false;
+}
+
+/// "a,b" → {"a", "b"} (empty items dropped).
+std::vector<std::string> split_commas(const std::string& list) {
+  std::vector<std::string> items;
+  std::istringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) items.push_back(item);
+  return items;
+}
+
+/// What the command line asked for.
+struct Invocation {
   Options o;
-  std::string command, out, docs;
+  std::string command;
+  std::string only;            // as typed, for the page's command line
+  bool default_paths = false;  // --out and --docs left at their defaults
+};
+
+/// Parses argv; returns an exit code when the program should stop (help, bad usage).
+std::optional<int> parse(int argc, char** argv, Invocation& inv) {
+  std::string out, docs;
+  const std::string src = TUMBLE_BENCH_SOURCE_DIR;
   po::options_description visible(
-      "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact> [options]\n"
-      "Options");
+      "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact|stages> "
+      "[options]\nOptions");
   visible.add_options()("help,h", "this help")(
-      "quick", po::bool_switch(&o.quick), "short version of everything (< 60 s), for ctest")(
-      "out", po::value(&out)->default_value(std::string(TUMBLE_BENCH_SOURCE_DIR) + "/bench/results"),
+      "quick", po::bool_switch(&inv.o.quick), "short version of everything (< 60 s), for ctest")(
+      "out", po::value(&out)->default_value(src + "/bench/results"),
       "results directory (CSV, SVG plots, section markdown)")(
-      "docs", po::value(&docs)->default_value(std::string(TUMBLE_BENCH_SOURCE_DIR) + "/docs/benchmarks.md"),
-      "Markdown page assembled from the results")(
-      "no-plots", "skip gnuplot")("repeats", po::value(&o.repeats)->default_value(3),
-                                 "interleaved repetitions of each timing (median)");
-  po::options_description hidden;
-  hidden.add_options()("command", po::value(&command));
+      "docs", po::value(&docs)->default_value(src + "/docs/benchmarks.md"),
+      "Markdown page assembled from the results")("no-plots", "skip gnuplot")(
+      "repeats", po::value(&inv.o.repeats)->default_value(3),
+      "interleaved repetitions of each timing (median)")(
+      "only", po::value(&inv.only),
+      "contact, stages: only these scenes, comma-separated (e.g. pyramid_large)");
   po::options_description all;
-  all.add(visible).add(hidden);
+  all.add(visible).add_options()("command", po::value(&inv.command));
   po::positional_options_description pos;
   pos.add("command", 1);
   po::variables_map vm;
@@ -107,43 +139,53 @@ int main(int argc, char** argv) {
     std::cerr << e.what() << '\n' << visible << '\n';
     return 2;
   }
-  if (vm.count("help") || command.empty() || (command != "all" && !commands.count(command))) {
+  if (vm.count("help") || !known(inv.command)) {
     std::cerr << visible << '\n';
     return vm.count("help") ? 0 : 2;
   }
-  o.out = out;
-  o.docs = docs;
-  o.plots = !vm.count("no-plots");
-  if (o.quick) o.repeats = std::min(o.repeats, 1);
-  fs::create_directories(o.out);
+  inv.o.out = out;
+  inv.o.docs = docs;
+  inv.o.plots = !vm.count("no-plots");
+  if (inv.o.quick) inv.o.repeats = std::min(inv.o.repeats, 1);
+  inv.o.only = split_commas(inv.only);
+  inv.default_paths = vm["out"].defaulted() && vm["docs"].defaulted();
+  return std::nullopt;
+}
 
-  std::ostringstream cmdline;
-  cmdline << "tumble-bench " << command << (o.quick ? " --quick" : "");
-  if (vm["out"].defaulted() && vm["docs"].defaulted()) {
-    cmdline.str("");
-    cmdline << "cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
-               "-DTUMBLE_BUILD_SERVER=OFF && ninja -C build/bench tumble-bench && "
-               "build/bench/bench/tumble-bench "
-            << command << (o.quick ? " --quick" : "");
-  }
+/// The command printed at the top of the page: the whole build-and-run recipe when the
+/// results go to their default places, else the bench command alone.
+std::string page_command_line(const Invocation& inv) {
+  const std::string bench = "tumble-bench " + inv.command + (inv.o.quick ? " --quick" : "") +
+                            (inv.only.empty() ? "" : " --only " + inv.only);
+  if (!inv.default_paths) return bench;
+  return "cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
+         "-DTUMBLE_BUILD_SERVER=OFF && ninja -C build/bench tumble-bench && build/bench/bench/" +
+         bench;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Invocation inv;
+  if (const std::optional<int> stop = parse(argc, argv, inv)) return *stop;
+  const Options& o = inv.o;
+  fs::create_directories(o.out);
   record_value(o, "machine", machine_description());
   record_value(o, "date", today());
   record_value(o, "engine_commit", engine_commit());
 
   const double start = wall_seconds();
-  const std::vector<std::string> order = {"work-precision", "stability", "throughput", "skip",
-                                          "peers", "contact"};
   int failures = 0;
-  for (const std::string& name : order) {
-    if (command != "all" && command != name) continue;
+  for (const auto& [name, run] : kCommands) {
+    if (inv.command != "all" && inv.command != name) continue;
     std::cerr << "== " << name << '\n';
     try {
-      commands.at(name)(o);
+      run(o);
     } catch (const std::exception& e) {
       std::cerr << name << " failed: " << e.what() << '\n';
       ++failures;
     }
-    assemble_docs(o, cmdline.str());
+    assemble_docs(o, page_command_line(inv));
   }
   std::cerr << "done in " << fixed(wall_seconds() - start, 1) << " s; docs: " << o.docs.string()
             << '\n';

@@ -63,6 +63,26 @@ tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed, BoxShape 
   return s;
 }
 
+tumble::Scene landing_cubes(std::size_t n, unsigned seed) {
+  tumble::Scene s = empty_floor_scene("landing_cubes", 1.0 / 240.0);
+  s.world.floor = tumble::Floor{0.0, 0.0, 1.0};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> height(1.0, 3.0), spin(-3.0, 3.0);
+  const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(n))));
+  constexpr double kSpacing = 3.0;  // m
+  s.bodies.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    tumble::BodyDef b;
+    b.name = "cube" + std::to_string(i);
+    b.position = {kSpacing * static_cast<double>(i % side), height(rng),
+                  kSpacing * static_cast<double>(i / side)};
+    b.orientation = random_orientation(rng);
+    b.angular_velocity = {spin(rng), spin(rng), spin(rng)};
+    s.bodies.push_back(b);
+  }
+  return s;
+}
+
 tumble::Scene resting_and_falling(std::size_t resting, std::size_t falling) {
   tumble::Scene s = empty_floor_scene("resting_and_falling", 1.0 / 60.0);
   const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(resting))));

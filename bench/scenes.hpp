@@ -31,6 +31,13 @@ const char* to_string(BoxShape shape);
 tumble::Scene separated_boxes(std::size_t n, double dt, unsigned seed = 42,
                               BoxShape shape = BoxShape::general);
 
+/// N separated unit cubes (1 kg) dropped from 1–3 m (centre height) with random orientation
+/// and spin up to 3 rad/s per axis (fixed seed) onto a floor with μ = 1 and e = 0; dt = 1/240 s,
+/// `exact`, TOI `root`. A 3 m grid: a cube that lands tilted can roll or slide a little with
+/// friction, and its neighbours are 3 m away (centres ≥ 1.73 m apart never touch), so the boxes
+/// meet only the floor. The `landing` variant of throughput and peers.
+tumble::Scene landing_cubes(std::size_t n, unsigned seed = 42);
+
 /// `resting` unit cubes placed on the floor at rest plus `falling` ones dropped from 2 m with
 /// spin, all separated; frictionless floor with e = 0.5, dt = 1/60 s.
 tumble::Scene resting_and_falling(std::size_t resting, std::size_t falling);

@@ -1,4 +1,6 @@
-/// stability: stress tests, each with its pass criterion and the measured figure.
+/// stability: stress tests, each with its pass criterion and the measured figure. Measure
+/// (one Row per test), record (CSV, the table for the closing note), report
+/// (bench/text/stability.md).
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -6,6 +8,7 @@
 #include "benchmarks.hpp"
 #include "report.hpp"
 #include "scenes.hpp"
+#include "text.hpp"
 #include "tumble/world.hpp"
 
 namespace tumble_bench {
@@ -173,21 +176,26 @@ Row long_step(double v) {
           y >= -1e-9};
 }
 
-}  // namespace
+/// Every test on every integrator where it applies, in table order.
+struct Measurement {
+  long long_steps = 0;        // steps of the long runs
+  double rest_seconds = 0.0;  // simulated time of the resting runs, s
+  std::vector<Row> rows;
+};
 
-void run_stability(const Options& o) {
-  const long long_steps = o.quick ? 10000 : 1000000;
-  const double rest_seconds = o.quick ? 60.0 : 3600.0;
+Measurement measure(const Options& o) {
+  Measurement m;
+  m.long_steps = o.quick ? 10000 : 1000000;
+  m.rest_seconds = o.quick ? 60.0 : 3600.0;
   const std::size_t total = std::size(tumble::kIntegrators) * 4 + 3 + 1 + 2;
   Progress bar("stability", total);
-  std::vector<Row> rows;
   auto add = [&](Row r) {
-    rows.push_back(std::move(r));
+    m.rows.push_back(std::move(r));
     bar.tick();
   };
   for (Integrator i : tumble::kIntegrators) {
     bar.note("long run " + name(i));
-    add(long_run(i, long_steps));
+    add(long_run(i, m.long_steps));
   }
   for (Integrator i : tumble::kIntegrators) add(fast_spin(i));
   for (Integrator i : tumble::kIntegrators) {
@@ -196,40 +204,56 @@ void run_stability(const Options& o) {
   }
   for (Integrator i : tumble::kIntegrators) {
     bar.note("resting " + name(i));
-    add(resting(i, rest_seconds));
+    add(resting(i, m.rest_seconds));
   }
   for (double e : {0.0, 0.5, 0.9}) add(zeno(e));
   add(masses(o.quick));
   add(long_step(0.0));
   add(long_step(-100.0));
+  return m;
+}
 
-  const fs::path csv = o.out / "stability.csv";
+int passed(const Measurement& m) {
+  return static_cast<int>(std::count_if(m.rows.begin(), m.rows.end(),
+                                        [](const Row& r) { return r.pass; }));
+}
+
+/// stability.csv, stability_table.md (the closing note quotes it) and the headline value;
+/// returns the Markdown table.
+std::string record(const Options& o, const Measurement& m) {
   std::vector<std::vector<std::string>> table;
-  int passed = 0;
   {
-    Csv out(csv, {"test", "integrator", "criterion", "measured", "pass"});
-    for (const Row& r : rows) {
+    Csv out(o.out / "stability.csv", {"test", "integrator", "criterion", "measured", "pass"});
+    for (const Row& r : m.rows) {
       out.row() << r.test << r.integrator << r.criterion << r.measured << (r.pass ? "yes" : "no");
       table.push_back({r.test, "`" + r.integrator + "`", r.criterion, r.measured,
                        r.pass ? "pass" : "**FAIL**"});
-      passed += r.pass ? 1 : 0;
     }
   }
-  const std::string t =
-      md_table({"test", "integrator", "criterion", "measured", "result"}, table);
+  const std::string t = md_table({"test", "integrator", "criterion", "measured", "result"}, table);
   std::ofstream(o.out / "stability_table.md") << t;
-  record_value(o, "stability.passed", std::to_string(passed) + "/" + std::to_string(rows.size()));
-  std::ostringstream md;
-  md << "## Stability\n\n"
-     << "Stress tests with their pass criteria; " << passed << " of " << rows.size()
-     << " pass. Long runs: " << long_steps << " steps; resting: " << fmt(rest_seconds / 3600.0)
-     << " h of simulated time. CSV: " << file_link(o, csv) << ".\n\n"
-     << t
-     << "\nWhat it shows: which integrators keep the invariants of free rotation over very "
-        "long runs and large steps (criteria chosen so that a symplectic or exact scheme "
-        "passes and an energy-drifting one fails), and whether contact stays exact at the "
-        "extremes (rest, Zeno, mass range, a step longer than the whole fall).\n\n";
-  write_section(o, "stability", md.str());
+  record_value(o, "stability.passed",
+               std::to_string(passed(m)) + "/" + std::to_string(m.rows.size()));
+  return t;
+}
+
+void report(const Options& o, const Measurement& m, const std::string& table) {
+  const Fields f{
+      {"passed", std::to_string(passed(m))},
+      {"tests", std::to_string(m.rows.size())},
+      {"long_steps", std::to_string(m.long_steps)},
+      {"rest_hours", fmt(m.rest_seconds / 3600.0)},
+      {"csv", file_link(o, o.out / "stability.csv")},
+      {"table", table},
+  };
+  write_section(o, "stability", fill_template("stability", f));
+}
+
+}  // namespace
+
+void run_stability(const Options& o) {
+  const Measurement m = measure(o);
+  report(o, m, record(o, m));
 }
 
 }  // namespace tumble_bench

@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Writes the box-contact scenes (tower, pyramid, pile, heavy_on_light, dominoes) into scenes/.
+"""Writes the box-contact scenes (tower, pyramid, pyramid_large, pile, heavy_on_light, dominoes)
+into scenes/.
 
 Run from the repository root: python3 tools/make_contact_scenes.py
 The pile uses a fixed seed, so the files are reproducible.
@@ -38,16 +39,24 @@ def tower():
                  "tower must stand still without sinking or drifting, then sleep.", bodies)
 
 
-def pyramid(base=20, gap=0.05):
+def pyramid(base=20, gap=0.05, mass=1, name="pyramid"):
+    """A 2-D pyramid in the x–y plane: row r holds base − r unit cubes, centres 1 + gap apart
+    (so neighbours in a row never touch), resting exactly on the row below (y = 0.5 + r)."""
     bodies = []
     for row in range(base):
         for i in range(base - row):
             x = (i - 0.5 * (base - row - 1)) * (1 + gap)
-            bodies.append(box(f"r{row}b{i}", [1, 1, 1], 1, [x, 0.5 + row, 0],
+            bodies.append(box(f"r{row}b{i}", [1, 1, 1], mass, [x, 0.5 + row, 0],
                               COLORS[row % len(COLORS)]))
-    return scene("pyramid", f"A 2D pyramid of unit cubes with a base of {base} "
-                 f"({len(bodies)} boxes, 5 cm gaps within a row; e = 0, mu = 0.6): it must "
-                 "stand and fall asleep.", bodies)
+    heavy = "" if mass == 1 else f"{mass} kg each, "
+    return scene(name, f"A 2D pyramid of unit cubes with a base of {base} "
+                 f"({len(bodies)} boxes, {heavy}{round(gap * 100)} cm gaps within a row; "
+                 "e = 0, mu = 0.6): it must stand and fall asleep.", bodies)
+
+
+def pyramid_large():
+    """The base-100 version of `pyramid` (5,050 boxes of 100 kg): the large stack of issue 11."""
+    return pyramid(base=100, mass=100, name="pyramid_large")
 
 
 def quat_from_axis_angle(axis, angle):
@@ -99,7 +108,7 @@ def dominoes(n=20):
 
 
 def main():
-    for s in (tower(), pyramid(), pile(), heavy_on_light(), dominoes()):
+    for s in (tower(), pyramid(), pyramid_large(), pile(), heavy_on_light(), dominoes()):
         path = SCENES / f"{s['name']}.json"
         text = json.dumps(s, indent=1)
         path.write_text(text + "\n")

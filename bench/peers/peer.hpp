@@ -12,8 +12,8 @@
 
 namespace tumble_bench {
 
-using Vec3 = Eigen::Vector3d;
-using Quat = Eigen::Quaterniond;
+using Vec3 = Eigen::Vector3d;     ///< Vectors in the world frame.
+using Quat = Eigen::Quaterniond;  ///< Orientations, body → world.
 
 /// One box as a peer sees it (SI units, angular velocity in the world frame).
 struct PeerBox {
@@ -50,13 +50,20 @@ struct PeerBodyState {
 /// A live peer world.
 class PeerWorld {
  public:
-  virtual ~PeerWorld() = default;
+  virtual ~PeerWorld() = default;  ///< Frees the peer's world.
   /// Advances by the scene's dt.
   virtual void step() = 0;
   /// State of body i.
   virtual PeerBodyState state(std::size_t i) const = 0;
   /// Bodies the peer currently simulates (not deactivated), or -1 if it cannot say.
   virtual long awake_count() const { return -1; }
+  /// Impacts resolved since the world was built (floor and body–body), or -1 when the engine
+  /// has no such counter (no peer has one: they resolve contacts, not impacts).
+  virtual long long impacts() const { return -1; }
+  /// Called before each step of a run that must keep every body awake (`step` counts from 1).
+  /// Peers are built with sleeping off for such runs (PeerScene::allow_sleep) and do nothing
+  /// here; Tumble, which has no such switch, wakes its bodies.
+  virtual void keep_awake(long /*step*/) {}
   /// What went wrong so far in a way that changes the simulation (a full contact buffer …),
   /// empty when nothing did.
   virtual std::string trouble() const { return {}; }

@@ -1,0 +1,83 @@
+#include "contenders.hpp"
+
+#include <cmath>
+
+#include "common.hpp"
+#include "scenes.hpp"
+#include "tumble/world.hpp"
+
+namespace tumble_bench {
+namespace {
+
+/// Tumble behind the peers' interface, so every engine is driven by the same loop.
+class TumbleAsPeer final : public PeerWorld {
+ public:
+  explicit TumbleAsPeer(const tumble::Scene& s) : w_(s) {}
+  void step() override { w_.step(); }
+  PeerBodyState state(std::size_t i) const override {
+    const tumble::Body& b = w_.body(static_cast<tumble::BodyId>(i));
+    return {b.s.x, Quat(b.s.R), tumble::velocity(b.s, b.c), tumble::angular_velocity(b.s, b.c)};
+  }
+  long awake_count() const override { return static_cast<long>(w_.awake_count()); }
+  long long impacts() const override { return static_cast<long long>(w_.total_impacts()); }
+  /// A zero impulse on every body every 15 steps wakes its island (Tumble has no switch to
+  /// turn sleeping off; 15 steps is well below the 0.5 s sleep timer at dt = 1/60).
+  void keep_awake(long step) override {
+    if (step % 15 != 0) return;
+    for (std::size_t i = 0; i < w_.bodies().size(); ++i)
+      w_.apply_impulse(static_cast<tumble::BodyId>(i), tumble::Vec3::Zero());
+  }
+
+ private:
+  tumble::World w_;
+};
+
+Contender peer_contender(const PeerEngine& p) {
+  const std::string note = p.name == "bullet" ? "DISABLE_DEACTIVATION on every body"
+                           : p.name == "ode"  ? "auto-disable off"
+                                              : "no sleeping in MuJoCo 2.2: always awake";
+  return {p.name,
+          [make = p.make](const tumble::Scene& s, const PeerSetup& setup) {
+            PeerScene ps = to_peer(s);
+            ps.stacking = setup.stacking;
+            ps.allow_sleep = setup.allow_sleep;
+            return make(ps);
+          },
+          note, p.name.rfind("mujoco", 0) != 0};
+}
+
+}  // namespace
+
+std::vector<Contender> contenders(bool with_rk4) {
+  std::vector<Contender> c;
+  c.push_back({"tumble",
+               [](const tumble::Scene& s, const PeerSetup&) {
+                 return std::make_unique<TumbleAsPeer>(s);
+               },
+               "zero impulse on every body every 15 steps", true});
+  for (const PeerEngine& p : available_peers()) c.push_back(peer_contender(p));
+#ifdef TUMBLE_BENCH_HAVE_MUJOCO
+  if (with_rk4) c.push_back(peer_contender(mujoco_peer(true)));
+#else
+  (void)with_rk4;
+#endif
+  return c;
+}
+
+double timed_run(const Contender& c, const tumble::Scene& s, long steps,
+                 std::unique_ptr<PeerWorld>* keep, std::string* why) {
+  std::unique_ptr<PeerWorld> w;
+  try {
+    w = c.make(s, PeerSetup{});
+  } catch (const std::exception& e) {
+    if (why) *why = e.what();
+    return NAN;
+  }
+  const double t0 = thread_cpu_seconds();
+  for (long i = 0; i < steps; ++i) w->step();
+  const double cpu = thread_cpu_seconds() - t0;
+  if (keep) *keep = std::move(w);
+  return cpu;
+}
+
+}  // namespace tumble_bench
