@@ -39,6 +39,7 @@ struct Totals {
 
 Totals run_once(const Spec& spec, const tumble::Scene& scene) {
   tumble::World w(scene);
+  w.set_stage_timing(true);  // off by default: two clock reads per stage
   Totals t;
   for (long i = 1; i <= spec.steps; ++i) {
     if (spec.keep_awake && i % 15 == 0)
