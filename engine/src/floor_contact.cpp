@@ -39,6 +39,12 @@ ContactSet touching_vertices(const BodyState& s, const BodyConstants& c, double 
   return set;
 }
 
+/// The patch friction impulse of one exchange and its Coulomb limit μ Σ jₙ, N·s.
+struct PatchFriction {
+  double impulse = 0.0;
+  double limit = 0.0;
+};
+
 /// Kinematic state of the body during an impulse exchange (I⁻¹ is fixed over an impulse).
 struct Kinematics {
   Vec3 v;
@@ -115,7 +121,7 @@ Kinematics kinematics_of(const BodyState& s, const BodyConstants& c) {
 // load shifts to the leading edge of a sliding box instead of tipping it, and a flat slide
 // decelerates at exactly μ g.
 int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const Impulses& target,
-            double mu) {
+            double mu, PatchFriction* patch = nullptr) {
   if (set.count == 0) return 0;
   const BodyState s0 = s;
   const Kinematics k0 = kinematics_of(s, c);
@@ -160,6 +166,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
     s.L += twist * up;
     k.w += k.inv_inertia * (twist * up);
     normal = solve_normal(s, k, set, system, target);
+    if (patch) *patch = {friction.norm(), mu * total};
     if (settled) break;
   }
   return set.count;
@@ -187,6 +194,22 @@ bool in_resting_contact(const BodyState& s, const BodyConstants& c, double floor
   return false;
 }
 
+// Horizontal travel of a body in resting contact over a step of h seconds. Kinetic friction
+// acts at its Coulomb limit μ Σ jₙ: a constant force while the patch slides. The patch took
+// the friction impulse F ≤ μ Σ jₙ, so it slid for t_s = h F / (μ Σ jₙ), its centre moving along
+// a parabola from v₀ to v₁, and moved with v₁ for the rest of the step:
+// t_s (v₀ + v₁)/2 + (h − t_s) v₁. A slide through the whole step is the exact parabola; the
+// step in which a flat slide stops travels v₀ t_s / 2; a sticking patch (F = 0) moves with its
+// end-of-step velocity as the rest of the step does. So a flat slide stops at v₀²/(2 μ g) to
+// round-off at any dt, where moving with the end-of-step velocity stopped v₀ dt/2 short.
+Vec3 horizontal_travel(const Vec3& v0, const Vec3& v1, const PatchFriction& patch, double h) {
+  const Vec3 flat(1.0, 0.0, 1.0);
+  const Vec3 v0t = v0.cwiseProduct(flat), v1t = v1.cwiseProduct(flat);
+  if (patch.limit <= 0.0) return h * v1t;
+  const double slid = h * std::min(1.0, patch.impulse / patch.limit);
+  return 0.5 * slid * (v0t + v1t) + (h - slid) * v1t;
+}
+
 // Resting contact over h seconds, a velocity-level step in the spirit of Guendelman, Bridson
 // & Fedkiw 2003 (§5–6): gravity first, then inelastic contact impulses (with friction), then
 // positions with the corrected velocities. Touching vertices may not approach; a vertex that
@@ -197,7 +220,9 @@ bool in_resting_contact(const BodyState& s, const BodyConstants& c, double floor
 // the floor is projected back and its approach removed.
 void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
                   double h) {
+  const Vec3 v_start = c.inv_mass * s.P;
   s.P += (h * c.mass) * gravity;
+  PatchFriction patch;
   {
     const Kinematics k = kinematics_of(s, c);
     ContactSet set;
@@ -210,9 +235,10 @@ void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, dou
       target[set.count] = gap <= kContactBand ? 0.0 : -gap / h;
       set.r[set.count++] = r;
     }
-    resolve(s, c, set, target, c.friction);
+    resolve(s, c, set, target, c.friction, &patch);
   }
-  s.x += (h * c.inv_mass) * s.P;
+  s.x += horizontal_travel(v_start, c.inv_mass * s.P, patch, h);
+  s.x.y() += h * c.inv_mass * s.P.y();
   if (!s.L.isZero()) {
     s.R = rotation_from_vector(h * angular_velocity(s, c)) * s.R;
     orthonormalize(s.R);
