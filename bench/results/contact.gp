@@ -7,8 +7,8 @@ set grid
 set logscale y
 set title 'box–box contact: CPU ms per step while every body is awake'
 set ylabel 'CPU ms per step'
-set xrange [-0.6:2.6]
-set xtics ('tower (10)' 0, 'pyramid (210)' 1, 'pile (1000)' 2)
+set xrange [-0.6:3.6]
+set xtics ('tower (10)' 0, 'pyramid (210)' 1, 'pile (1000)' 2, 'pyramid_large (5050)' 3)
 set key top left
 set boxwidth 0.2
 set style fill solid 0.8
