@@ -66,4 +66,8 @@ double total_energy(const BodyState& s, const BodyConstants& c, const Vec3& grav
   return kinetic_energy(s, c) - c.mass * gravity.dot(s.x);
 }
 
+double point_speed_bound(const BodyState& s, const BodyConstants& c) {
+  return s.P.norm() * c.inv_mass + angular_velocity(s, c).norm() * c.bounding_radius;
+}
+
 }  // namespace tumble

@@ -24,11 +24,6 @@ bool touches(const BoxManifold& m, const Body& a, const Body& b, double dt) {
   return false;
 }
 
-/// Fastest point of a body: |v| + |ω| r, m/s.
-double point_speed_bound(const Body& b) {
-  return b.s.P.norm() * b.c.inv_mass + angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
-}
-
 Contact contact_of(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const Body& ba,
                    const Body& bb) {
   Contact c;
@@ -87,12 +82,14 @@ void collide_floor(StepContext& ctx) {
   s.reach.resize(ctx.bodies.size());
   for (std::uint32_t id : s.linked) s.reach[id] = 0.0;
   for (const Contact& c : s.box_contacts) {
-    s.reach[c.a] = std::max(s.reach[c.a], point_speed_bound(ctx.bodies[c.b]));
-    s.reach[c.b] = std::max(s.reach[c.b], point_speed_bound(ctx.bodies[c.a]));
+    const Body &a = ctx.bodies[c.a], &b = ctx.bodies[c.b];
+    s.reach[c.a] = std::max(s.reach[c.a], point_speed_bound(b.s, b.c));
+    s.reach[c.b] = std::max(s.reach[c.b], point_speed_bound(a.s, a.c));
   }
   for (std::uint32_t id : s.linked) {
     const Body& b = ctx.bodies[id];
-    const double margin = kSpeculativeDistance + ctx.dt * (point_speed_bound(b) + s.reach[id]);
+    const double margin =
+        kSpeculativeDistance + ctx.dt * (point_speed_bound(b.s, b.c) + s.reach[id]);
     Contact c;
     if (floor_contact(b.s, b.c, id, ctx.world.floor->height, margin, c) > 0)
       s.contacts.push_back(c);

@@ -10,14 +10,10 @@ namespace {
 constexpr double kSleepSpeed = 0.05;  // m/s
 constexpr double kSleepTime = 0.5;    // s
 
-/// Fastest point of a body: |v| + |ω| r, m/s.
-double point_speed_bound(const Body& b) {
-  return b.s.P.norm() * b.c.inv_mass + angular_velocity(b.s, b.c).norm() * b.c.bounding_radius;
-}
-
 void update_still_time(Body& b, double dt) {
   if (b.activity != Activity::awake) return;
-  b.still_time = b.in_contact && point_speed_bound(b) <= kSleepSpeed ? b.still_time + dt : 0.0;
+  const bool still = b.in_contact && point_speed_bound(b.s, b.c) <= kSleepSpeed;
+  b.still_time = still ? b.still_time + dt : 0.0;
 }
 
 bool ready_to_sleep(const Body& b) {

@@ -77,6 +77,9 @@ inline Vec3 velocity(const BodyState& s, const BodyConstants& c) { return s.P * 
 /// Angular velocity ω = R I_body⁻¹ Rᵀ L, rad/s, world frame.
 Vec3 angular_velocity(const BodyState& s, const BodyConstants& c);
 
+/// A bound on the speed of every point of the box: |v| + |ω| r (r its bounding radius), m/s.
+double point_speed_bound(const BodyState& s, const BodyConstants& c);
+
 /// World-frame inverse inertia I⁻¹ = R I_body⁻¹ Rᵀ.
 Mat3 inverse_inertia_world(const BodyState& s, const BodyConstants& c);
 
