@@ -15,9 +15,6 @@ namespace tumble {
 /// Most contact points one solve handles.
 inline constexpr int kMaxActiveSetPoints = 8;
 
-/// A K matrix (normal velocity change at i per unit impulse at j) of a few contact points.
-using PointMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxActiveSetPoints,
-                                  kMaxActiveSetPoints>;
 /// Per-point values (velocities, targets, impulses).
 using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActiveSetPoints, 1>;
 
@@ -40,11 +37,11 @@ struct ContactSide {
 // pseudo-inverse follows in closed form from 3×3 algebra: for D of full column rank,
 // K⁺ = D G⁻¹ S⁻¹ G⁻¹ Dᵀ with G = DᵀD (write D = QR: K = Q (R S Rᵀ) Qᵀ). This replaces the
 // eigendecomposition of the m×m K (m up to 8) that used to dominate the contact solve.
-/// The normal-impulse system K = D S Dᵀ of points sharing one normal.
+/// The normal-impulse system K = D S Dᵀ of points sharing one normal (K itself is never
+/// formed: every product with it goes through D and S).
 struct NormalSystem {
-  PlaneCoordinates D;  ///< (1, α, β) of each point.
-  Mat3 S = Mat3::Zero();  ///< Patch inverse mass in those coordinates.
-  PointMatrix K;       ///< D S Dᵀ, 1/kg.
+  PlaneCoordinates D;     ///< (1, α, β) of each point.
+  Mat3 S = Mat3::Zero();  ///< Patch inverse mass in those coordinates, 1/kg.
 };
 
 /// The system of points at `offsets` from a common plane origin (world vectors, m), normal n,
@@ -63,15 +60,13 @@ inline NormalSystem make_normal_system(const Vec3& n, const Vec3& t1, const Vec3
     sys.S += C.transpose() * side->inv_inertia * C;
     sys.S(0, 0) += side->inv_mass;
   }
-  sys.K = sys.D * sys.S * sys.D.transpose();
   return sys;
 }
 
 /// P with K⁺ = D P Dᵀ for K = D S Dᵀ (S symmetric positive definite): closed form when the
 /// points span the plane, else through the 3×3 eigendecomposition of G = DᵀD, dropping
 /// directions whose eigenvalue is below 1e-12 of the largest (collinear or coincident points).
-inline Mat3 pseudo_inverse_factor(const PlaneCoordinates& D, const Mat3& S) {
-  const Mat3 G = D.transpose() * D;
+inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   Mat3 P;  // K⁺ = D P Dᵀ
   const double det = G.determinant();
   if (det > 1e-10 * G(0, 0) * G(1, 1) * G(2, 2)) {
@@ -101,33 +96,38 @@ inline Mat3 pseudo_inverse_factor(const PlaneCoordinates& D, const Mat3& S) {
   return P;
 }
 
-/// K⁺ of K = D S Dᵀ as an m×m matrix.
-inline PointMatrix pseudo_inverse(const PlaneCoordinates& D, const Mat3& S) {
-  return D * pseudo_inverse_factor(D, S) * D.transpose();
+/// G = Σ dᵢ dᵢᵀ over the rows listed in idx[0..m).
+inline Mat3 gram(const PlaneCoordinates& D, const int* idx, int m) {
+  Mat3 G = Mat3::Zero();
+  for (int a = 0; a < m; ++a) {
+    const Vec3 d = D.row(idx[a]).transpose();
+    G.noalias() += d * d.transpose();
+  }
+  return G;
 }
 
-/// Pseudo-inverses of the sub-matrices of one K met so far, keyed by the active set: within
-/// one impulse exchange K is fixed, so repeated solves (friction rounds) reuse them.
+/// P with K⁺ = D P Dᵀ over all rows of D.
+inline Mat3 pseudo_inverse_factor(const PlaneCoordinates& D, const Mat3& S) {
+  std::array<int, kMaxActiveSetPoints> all{};
+  for (int i = 0; i < D.rows(); ++i) all[i] = i;
+  return pseudo_inverse_factor_of_gram(gram(D, all.data(), static_cast<int>(D.rows())), S);
+}
+
+/// Pseudo-inverse factors of the sub-systems of one K met so far, keyed by the active set:
+/// within one impulse exchange K is fixed, so repeated solves (friction rounds) reuse them.
 class ActiveSetCache {
  public:
   explicit ActiveSetCache(const NormalSystem& system) : system_(system) {}
-  /// The matrix solved.
-  const PointMatrix& K() const { return system_.K; }
-  /// K⁺ restricted to the points in `mask` (bit i = point i), listed in idx[0..m).
-  const PointMatrix& inverse(unsigned mask, const std::array<int, kMaxActiveSetPoints>& idx,
-                             int m) {
+  /// The system solved.
+  const NormalSystem& system() const { return system_; }
+  /// P with (K restricted to the points in `mask`)⁺ = D_a P D_aᵀ; the points are idx[0..m).
+  const Mat3& factor(unsigned mask, const std::array<int, kMaxActiveSetPoints>& idx, int m) {
     for (int c = 0; c < cached_; ++c)
-      if (masks_[c] == mask) return inverses_[c];
+      if (masks_[c] == mask) return factors_[c];
     const int slot = cached_ < kCache ? cached_++ : (next_++ % kCache);
     masks_[slot] = mask;
-    if (m == 1) {
-      inverses_[slot] = PointMatrix::Constant(1, 1, 1.0 / system_.K(idx[0], idx[0]));
-      return inverses_[slot];
-    }
-    PlaneCoordinates Da(m, 3);
-    for (int a = 0; a < m; ++a) Da.row(a) = system_.D.row(idx[a]);
-    inverses_[slot] = pseudo_inverse(Da, system_.S);
-    return inverses_[slot];
+    factors_[slot] = pseudo_inverse_factor_of_gram(gram(system_.D, idx.data(), m), system_.S);
+    return factors_[slot];
   }
 
  private:
@@ -135,7 +135,7 @@ class ActiveSetCache {
   const NormalSystem& system_;
   int cached_ = 0, next_ = 0;
   std::array<unsigned, kCache> masks_{};
-  std::array<PointMatrix, kCache> inverses_;
+  std::array<Mat3, kCache> factors_;
 };
 
 // Simultaneous normal impulses by an active-set solve (Baraff 1989, "Analytical methods for
@@ -146,11 +146,11 @@ class ActiveSetCache {
 // solve uses the pseudo-inverse; rigid-body targets are then consistent and a flat landing
 // stays flat. With e = 1 every active point reverses its normal velocity, which conserves
 // kinetic energy exactly: ΔT = Σ jᵢ (v⁻ᵢ + v⁺ᵢ)/2 = 0.
-/// Impulses (≥ 0) for points with normal velocities vn and targets; K from `cache`.
+/// Impulses (≥ 0) for points with normal velocities vn and targets; the system from `cache`.
 inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn,
                                     const PointVector& target) {
   const int n = static_cast<int>(vn.size());
-  const PointMatrix& K = cache.K();
+  const PlaneCoordinates& D = cache.system().D;
   std::array<bool, kMaxActiveSetPoints> active{};
   for (int i = 0; i < n; ++i) active[i] = vn(i) < target(i) - 1e-15;
   PointVector impulse = PointVector::Zero(n);
@@ -162,10 +162,10 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
       if (active[i]) idx[m++] = i, mask |= 1u << i;
     impulse.setZero();
     if (m > 0) {
-      PointVector b(m);
-      for (int a = 0; a < m; ++a) b(a) = target(idx[a]) - vn(idx[a]);
-      const PointVector ja = cache.inverse(mask, idx, m) * b;
-      for (int a = 0; a < m; ++a) impulse(idx[a]) = ja(a);
+      Vec3 y = Vec3::Zero();  // D_aᵀ (target − vn) over the active points
+      for (int a = 0; a < m; ++a) y += (target(idx[a]) - vn(idx[a])) * D.row(idx[a]).transpose();
+      const Vec3 z = cache.factor(mask, idx, m) * y;
+      for (int a = 0; a < m; ++a) impulse(idx[a]) = D.row(idx[a]).dot(z);
     }
     // Drop the most negative impulse, else add the most violated passive point.
     int worst = -1;
@@ -176,11 +176,14 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
       active[worst] = false;
       continue;
     }
-    const PointVector after = vn + K * impulse;
+    Vec3 load = Vec3::Zero();  // Dᵀ j
+    for (int i = 0; i < n; ++i) load += impulse(i) * D.row(i).transpose();
+    const Vec3 response = cache.system().S * load;  // K j = D S Dᵀ j
     worst_value = -1e-12;
-    for (int i = 0; i < n; ++i)
-      if (!active[i] && after(i) - target(i) < worst_value)
-        worst = i, worst_value = after(i) - target(i);
+    for (int i = 0; i < n; ++i) {
+      const double after = vn(i) + D.row(i).dot(response);
+      if (!active[i] && after - target(i) < worst_value) worst = i, worst_value = after - target(i);
+    }
     if (worst < 0) break;
     active[worst] = true;
   }
