@@ -75,31 +75,27 @@ void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& 
 // once per change of the sleeping set, and each awake box finds the sleeping ones it may
 // touch by binary search over that list.
 bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
-                std::span<const std::uint8_t> candidate, SweepScratch& scratch,
-                std::vector<BodyPair>& pairs, std::size_t max_pairs) {
+                std::span<const std::uint8_t> candidate,
+                std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
+                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs) {
   pairs.clear();
   const std::size_t n = boxes.size();
   scratch.start.resize(n);
-  std::uint64_t signature = 1469598103934665603ull;  // FNV-1a over the sleeping set
   std::size_t awake_count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::uint32_t i : awake_ids) {
     if (!candidate[i]) continue;
-    if (active[i]) {
-      scratch.start[i] = interval_start(boxes[i]);
-      ++awake_count;
-    } else {
-      signature = (signature ^ i) * 1099511628211ull;
-    }
+    scratch.start[i] = interval_start(boxes[i]);
+    ++awake_count;
   }
   // The awake list keeps last step's order for the bodies still awake, then appends the rest.
   std::vector<std::uint32_t>& awake = scratch.awake;
   std::erase_if(awake, [&](std::uint32_t i) { return i >= n || !candidate[i] || !active[i]; });
   const std::size_t kept = awake.size();
   if (kept != awake_count) {
-    std::vector<std::uint8_t> listed(n, 0);
-    for (std::uint32_t i : awake) listed[i] = 1;
-    for (std::size_t i = 0; i < n; ++i)
-      if (candidate[i] && active[i] && !listed[i]) awake.push_back(static_cast<std::uint32_t>(i));
+    scratch.listed.assign(n, 0);
+    for (std::uint32_t i : awake) scratch.listed[i] = 1;
+    for (std::uint32_t i : awake_ids)
+      if (candidate[i] && !scratch.listed[i]) awake.push_back(i);
   }
   if (awake.size() - kept > awake.size() / 8) {
     // Many newcomers (the first step, a mass wake-up): a full sort, not insertion.
@@ -109,7 +105,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   } else {
     sort_by_start(awake, scratch.start);
   }
-  if (signature != scratch.sleeping_signature) {
+  if (sleeping_key != scratch.sleeping_signature) {
     scratch.sleeping.clear();
     scratch.sleeping_width = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -124,7 +120,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
                 return scratch.start[a] < scratch.start[b] ||
                        (scratch.start[a] == scratch.start[b] && a < b);
               });
-    scratch.sleeping_signature = signature;
+    scratch.sleeping_signature = sleeping_key;
   }
   const std::vector<std::uint32_t>& sleeping = scratch.sleeping;
   bool complete = true;
@@ -167,28 +163,45 @@ bool overlaps(const Aabb& a, const Aabb& b) {
   return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
 }
 
-/// Each body's swept box and flags. A sleeping body does not move: its box (and candidacy)
-/// is computed once, when it is first seen asleep, so 10,000 sleeping boxes cost a flag test
-/// each per step.
-void update_boxes(StepContext& ctx) {
+/// One body's swept box and candidacy; returns whether its candidacy changed.
+bool update_box(StepContext& ctx, std::uint32_t i) {
   BroadPhaseCache& k = ctx.broad;
-  StepScratch& s = ctx.scratch;
+  const Body& b = ctx.bodies[i];
+  const bool awake = k.active[i] != 0;
+  k.boxes[i] = swept_aabb(b.s, b.c, ctx.world.gravity, awake ? ctx.dt : 0.0,
+                          0.5 * kSpeculativeDistance);
+  k.box_cached[i] = !awake;
+  // A body about to go non-finite (an overflowing impulse) touches nothing: it flies alone
+  // and finalize freezes it.
+  const std::uint8_t candidate = b.activity != Activity::frozen &&
+                                 std::isfinite(k.boxes[i].lo.sum() + k.boxes[i].hi.sum());
+  const bool changed = candidate != k.candidate[i];
+  k.candidate[i] = candidate;
+  return changed;
+}
+
+/// Every body's flags and the awake list, after an activity changed (the epoch moved). A
+/// sleeping body does not move: its box is computed once, when it is first seen asleep, and
+/// is its own fat box.
+void rescan(StepContext& ctx) {
+  BroadPhaseCache& k = ctx.broad;
   const std::size_t n = ctx.bodies.size();
+  k.epoch = ctx.cache.activity_epoch;
   k.boxes.resize(n);
+  k.fat.resize(n);
   k.box_cached.resize(n, 0);
-  s.active.resize(n);
-  s.candidate.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Body& b = ctx.bodies[i];
-    s.active[i] = b.activity == Activity::awake;
-    if (!s.active[i] && k.box_cached[i]) continue;
-    k.boxes[i] = swept_aabb(b.s, b.c, ctx.world.gravity, s.active[i] ? ctx.dt : 0.0,
-                            0.5 * kSpeculativeDistance);
-    k.box_cached[i] = !s.active[i];
-    // A body about to go non-finite (an overflowing impulse) touches nothing: it flies alone
-    // and finalize freezes it.
-    s.candidate[i] = b.activity != Activity::frozen &&
-                     std::isfinite(k.boxes[i].lo.sum() + k.boxes[i].hi.sum());
+  k.active.resize(n);
+  k.candidate.resize(n);
+  k.awake.clear();
+  for (std::uint32_t i = 0; i < n; ++i) {
+    k.active[i] = ctx.bodies[i].activity == Activity::awake;
+    if (k.active[i]) {
+      k.awake.push_back(i);
+      continue;
+    }
+    if (k.box_cached[i]) continue;
+    update_box(ctx, i);
+    k.fat[i] = k.boxes[i];
   }
 }
 
@@ -198,32 +211,28 @@ void update_boxes(StepContext& ctx) {
 // body changes activity (Box2D's fat AABBs, Catto 2019 "Dynamic bounding volume
 // hierarchies"): a falling box moves a few centimetres a step, so the sweep runs about once
 // every ten steps and the steps between only filter the cached pairs by the tight boxes.
+// Between changes of activity (counted by ContactCache::activity_epoch) a step touches only
+// the awake bodies: 10,000 sleeping boxes cost nothing.
 void broad_phase(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
+  BroadPhaseCache& k = ctx.broad;
   s.pairs.clear();
   const std::size_t n = ctx.bodies.size();
-  if (n < 2 || std::none_of(ctx.bodies.begin(), ctx.bodies.end(),
-                            [](const Body& b) { return b.activity == Activity::awake; }))
-    return;
-  update_boxes(ctx);
-  BroadPhaseCache& k = ctx.broad;
-  bool rebuild = k.fat.size() != n;
-  std::uint64_t signature = 1469598103934665603ull;
-  for (std::size_t i = 0; i < n && !rebuild; ++i) {
-    signature = (signature ^ (s.active[i] | (s.candidate[i] << 1))) * 1099511628211ull;
-    if (s.active[i] && !contains(k.fat[i], k.boxes[i])) rebuild = true;
-  }
-  if (rebuild || signature != k.fat_signature) {
-    k.fat.resize(n);
-    signature = 1469598103934665603ull;
-    for (std::size_t i = 0; i < n; ++i) {
-      signature = (signature ^ (s.active[i] | (s.candidate[i] << 1))) * 1099511628211ull;
-      const double margin = s.active[i] ? 0.5 * ctx.bodies[i].c.bounding_radius : 0.0;
+  const bool full = k.epoch != ctx.cache.activity_epoch || k.active.size() != n;
+  if (full) rescan(ctx);
+  bool rebuild = full || !k.fat_valid;
+  for (std::uint32_t i : k.awake) rebuild = update_box(ctx, i) || rebuild;
+  if (n < 2 || k.awake.empty()) return;
+  for (std::size_t a = 0; a < k.awake.size() && !rebuild; ++a)
+    rebuild = !contains(k.fat[k.awake[a]], k.boxes[k.awake[a]]);
+  if (rebuild) {
+    for (std::uint32_t i : k.awake) {
+      const double margin = 0.5 * ctx.bodies[i].c.bounding_radius;
       k.fat[i] = {k.boxes[i].lo.array() - margin, k.boxes[i].hi.array() + margin};
     }
-    k.fat_signature = signature;
-    k.fat_complete = find_pairs(k.fat, s.active, s.candidate, k.sweep, k.fat_pairs,
-                                pair_budget(n));
+    k.fat_complete = find_pairs(k.fat, k.active, k.candidate, k.awake, k.epoch, k.sweep,
+                                k.fat_pairs, pair_budget(n));
+    k.fat_valid = true;
   }
   for (const BodyPair& p : k.fat_pairs)
     if (overlaps(k.boxes[p.first], k.boxes[p.second])) s.pairs.push_back(p);
@@ -243,7 +252,9 @@ std::size_t initial_pairs(std::span<const Body> bodies, const Vec3& gravity) {
     boxes[i] = swept_aabb(bodies[i].s, bodies[i].c, gravity, 0.0, 0.5 * kSpeculativeDistance);
   SweepScratch sweep;
   std::vector<BodyPair> pairs;
-  find_pairs(boxes, active, candidate, sweep, pairs, pair_budget(n) + 1);
+  std::vector<std::uint32_t> all(n);
+  for (std::size_t i = 0; i < n; ++i) all[i] = static_cast<std::uint32_t>(i);
+  find_pairs(boxes, active, candidate, all, 0, sweep, pairs, pair_budget(n) + 1);
   return pairs.size();
 }
 

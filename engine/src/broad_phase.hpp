@@ -32,20 +32,23 @@ struct SweepScratch {
   std::vector<std::uint32_t> awake;       ///< Awake candidates, sorted by their interval start.
   std::vector<std::uint32_t> sleeping;    ///< Sleeping candidates, sorted likewise.
   std::vector<double> start;              ///< Interval start of each body along the sweep.
-  std::uint64_t sleeping_signature = ~0ull;  ///< Which set `sleeping` was sorted for.
+  std::uint64_t sleeping_signature = ~0ull;  ///< Which sleeping set `sleeping` was sorted for.
+  std::vector<std::uint8_t> listed;       ///< Scratch: body already in `awake`.
   double sleeping_width = 0.0;            ///< Widest sleeping interval, m.
 };
 
 /// Every pair whose boxes overlap and of which at least one body is `active` (sleeping pairs
 /// stay asleep), in ascending (first, second) order. `candidate[i]` false leaves body i out
-/// entirely (frozen bodies). Cost: the awake bodies re-sort in about linear time (insertion
+/// entirely (frozen bodies). `awake_ids` lists the active bodies; `sleeping_key` names the
+/// set of sleeping candidates and their boxes: the caller changes it whenever they change. Cost: the awake bodies re-sort in about linear time (insertion
 /// sort on last step's order); the sleeping ones are sorted only when their set changes and
 /// are found by binary search, so 10,000 sleeping boxes cost nothing per step. Stops after
 /// `max_pairs` pairs (a bound on the memory and time one step can take when a scene packs
 /// bodies into one another) and returns false then; true when every pair was found.
 bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
-                std::span<const std::uint8_t> candidate, SweepScratch& scratch,
-                std::vector<BodyPair>& pairs, std::size_t max_pairs);
+                std::span<const std::uint8_t> candidate,
+                std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
+                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs);
 
 /// The pair budget of a world of `body_count` bodies: 32 per body plus 1,024. A resting pile
 /// has about 7 per body (`pile`: 6,852 pairs for 1,000 bodies at most).

@@ -24,6 +24,7 @@ void finalize(StepContext& ctx) {
     if (!state_finite(b.s)) {
       b.s = s.before[k];
       b.activity = Activity::frozen;
+      ++ctx.cache.activity_epoch;
       ++ctx.stats.newly_frozen;
       continue;
     }

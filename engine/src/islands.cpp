@@ -69,10 +69,16 @@ void islands(StepContext& ctx) {
     s.solver_bodies.assign(s.island.members.begin(), s.island.members.end());
     std::sort(s.solver_bodies.begin(), s.solver_bodies.end());
   }
-  for (std::size_t i = 0; i < n; ++i)
-    if (ctx.bodies[i].activity == Activity::awake &&
-        (s.links.empty() || s.island.island_of[i] < 0))
-      s.lone_bodies.push_back(static_cast<std::uint32_t>(i));
+  // The broad phase's awake list is current unless the last detection round woke bodies.
+  if (ctx.broad.epoch == ctx.cache.activity_epoch) {
+    for (std::uint32_t i : ctx.broad.awake)
+      if (s.links.empty() || s.island.island_of[i] < 0) s.lone_bodies.push_back(i);
+  } else {
+    for (std::uint32_t i = 0; i < n; ++i)
+      if (ctx.bodies[i].activity == Activity::awake &&
+          (s.links.empty() || s.island.island_of[i] < 0))
+        s.lone_bodies.push_back(i);
+  }
   s.stepped = s.solver_bodies;
   s.stepped.insert(s.stepped.end(), s.lone_bodies.begin(), s.lone_bodies.end());
   s.before.clear();

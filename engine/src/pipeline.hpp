@@ -34,25 +34,30 @@ struct ContactCache {
   std::vector<Contact> previous;
   /// (pair key, index into previous), sorted by key.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> previous_keys;
+  /// Counts changes of any body's activity (wake, sleep, freeze): caches derived from the
+  /// activity flags are valid while it stays put.
+  std::uint64_t activity_epoch = 0;
 };
 
 /// Broad-phase acceleration kept between steps. It never changes a result (the pairs come out
 /// sorted whatever the cache held), so a World's copy starts without it.
 struct BroadPhaseCache {
+  std::uint64_t epoch = ~0ull;           ///< ContactCache::activity_epoch of the flags below.
+  std::vector<std::uint32_t> awake;      ///< Awake bodies, ascending.
+  std::vector<std::uint8_t> active;      ///< Body is awake.
+  std::vector<std::uint8_t> candidate;   ///< Body may touch anything (finite, not frozen).
   SweepScratch sweep;                    ///< Sweep-and-prune orders.
   std::vector<Aabb> boxes;               ///< Each body's swept box this step.
   std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
   std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
   std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
-  std::uint64_t fat_signature = 0;       ///< Activity flags the fat pairs were found for.
+  bool fat_valid = false;                ///< fat_pairs was found for the current flags.
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
 };
 
 /// Buffers of one step, reused between steps so that a step allocates nothing once warm.
 /// Holds no result: a World's copy starts with empty scratch.
 struct StepScratch {
-  std::vector<std::uint8_t> active;     ///< Body is awake this step.
-  std::vector<std::uint8_t> candidate;  ///< Body may touch anything (finite, not frozen).
   std::vector<BodyPair> pairs;          ///< Broad-phase pairs (sorted).
   std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
   std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.

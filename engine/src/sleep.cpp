@@ -23,6 +23,7 @@ bool ready_to_sleep(const Body& b) {
 /// Puts the island `members` to sleep as one ring.
 void fall_asleep(ContactCache& cache, std::span<Body> bodies,
                  std::span<const std::uint32_t> members) {
+  ++cache.activity_epoch;
   for (std::size_t n = 0; n < members.size(); ++n) {
     Body& b = bodies[members[n]];
     b.activity = Activity::asleep;
@@ -40,6 +41,7 @@ void init_caches(ContactCache& cache, std::size_t body_count) {
 }
 
 void wake_island(ContactCache& cache, std::span<Body> bodies, std::uint32_t id) {
+  ++cache.activity_epoch;
   std::uint32_t i = id;
   do {
     Body& b = bodies[i];
