@@ -50,7 +50,30 @@ bool valid_websocket_key(std::string_view key) {
   return std::string_view("AQgw").find(key[21]) != std::string_view::npos;
 }
 
-// The query parameter `name` of `target`, "" when absent.
+// `text` with %XX escapes and '+' (form encoding, as URLSearchParams writes a space) decoded;
+// a malformed escape is kept as it is (it then matches no token).
+std::string form_decode(std::string_view text) {
+  const auto hex = [](char c) {
+    return std::isxdigit(static_cast<unsigned char>(c))
+               ? (std::isdigit(static_cast<unsigned char>(c)) ? c - '0' : (c | 0x20) - 'a' + 10)
+               : -1;
+  };
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '+') {
+      out += ' ';
+    } else if (text[i] == '%' && i + 2 < text.size() && hex(text[i + 1]) >= 0 &&
+               hex(text[i + 2]) >= 0) {
+      out += static_cast<char>(hex(text[i + 1]) * 16 + hex(text[i + 2]));
+      i += 2;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+// The query parameter `name` of `target` (still encoded), "" when absent.
 std::string_view query_parameter(std::string_view target, std::string_view name) {
   const std::size_t q = target.find('?');
   if (q == std::string_view::npos) return {};
@@ -194,7 +217,8 @@ void HttpSession::upgrade(Request&& req) {
   if (!origin_allowed(req, ctx_.options))
     return send(error_response(req, 403, "WebSocket from this origin is not allowed", "Origin"));
   if (ctx_.options.token_reads && !authorised(req, ctx_.options) &&
-      !token_matches(query_parameter(req.target(), "access_token"), ctx_.options.token))
+      !token_matches(form_decode(query_parameter(req.target(), "access_token")),
+                     ctx_.options.token))
     return send(error_response(req, 401, "missing or wrong token", "Authorization"));
   if (ctx_.broadcaster.viewers() >= static_cast<std::size_t>(ctx_.options.max_viewers))
     return send(error_response(req, 503, "too many viewers", ""));

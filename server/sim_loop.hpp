@@ -56,9 +56,10 @@ class SimLoop {
   static constexpr double kMaxCatchUp = 0.1;
   /// Longest the loop steps (wall time) before it looks at the command queue again.
   static constexpr std::chrono::milliseconds kStepBudget{20};
-  /// Fastest linear speed (m/s) an impulse may give a body, and fastest spin (rad/s): a kick
-  /// past either (that does not slow the body) is refused with 400, the world untouched.
+  /// Fastest linear speed (m/s) an impulse may give a body: a kick past it (that does not
+  /// slow the body) is refused with 400, the world untouched.
   static constexpr double kMaxSpeed = 1e3;
+  /// Fastest spin (rad/s) an impulse may give a body; the same rule.
   static constexpr double kMaxSpin = 1e3;
   /// Wall-time window (s) over which the real-time factor is measured.
   static constexpr double kRtfWindow = 2.0;

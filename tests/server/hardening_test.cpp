@@ -394,6 +394,8 @@ TEST_F(TokenReads, ReadsAndViewersNeedTheTokenHealthDoesNot) {
   EXPECT_EQ(raw_request(port_, "GET /ws HTTP/1.1\r\n" + upgrade).status, 401u);
   EXPECT_EQ(raw_request(port_, "GET /ws?access_token=wrong HTTP/1.1\r\n" + upgrade).status, 401u);
   EXPECT_EQ(raw_request(port_, "GET /ws?access_token=t0ken HTTP/1.1\r\n" + upgrade).status, 101u);
+  EXPECT_EQ(raw_request(port_, "GET /ws?v=1&access_token=t0%6Ben HTTP/1.1\r\n" + upgrade).status,
+            101u);  // Percent-encoded, as a browser's URLSearchParams may write it.
 }
 
 // ---- Item 8: per-client budget for expensive reads --------------------------------------
