@@ -100,7 +100,10 @@ bool costly_read(const Request& req) {
 
 HttpSession::HttpSession(net::ip::tcp::socket&& socket, ServerContext& ctx,
                          ConnectionCount::Slot slot)
-    : stream_(std::move(socket)), ctx_(ctx), slot_(std::move(slot)) {
+    : stream_(std::move(socket)),
+      refusal_delay_(stream_.get_executor()),
+      ctx_(ctx),
+      slot_(std::move(slot)) {
   beast::error_code ec;
   const auto peer = stream_.socket().remote_endpoint(ec);
   if (!ec) client_ = peer.address().to_string();
@@ -181,7 +184,12 @@ void HttpSession::handle(Request&& req) {
       if (const int wait = ctx_.read_budget.admit(client_, cost)) {
         Response res = error_response(req, 429, "read budget of this client spent", "");
         res.set(http::field::retry_after, std::to_string(wait));
-        return reply_later(head, std::move(res));
+        refusal_delay_.expires_after(kRefusalDelay);
+        refusal_delay_.async_wait([self = shared_from_this(), head,
+                                   res = std::move(res)](beast::error_code) mutable {
+          self->reply_later(head, std::move(res));
+        });
+        return;
       }
     }
     handle_api(req, ctx_, [self = shared_from_this(), head](Response res) {

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 
@@ -27,6 +28,9 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   static constexpr std::uint32_t kHeaderLimit = tumble::server::kHeaderLimit;
   /// A connection idle (or a request unfinished) this long is closed.
   static constexpr std::chrono::seconds kIdleTimeout{30};
+  /// A 429 (read budget spent) is answered this much later: a client looping on its 429s
+  /// without honouring Retry-After gets 10 answers a second per connection, not thousands.
+  static constexpr std::chrono::milliseconds kRefusalDelay{100};
 
   /// Takes over an accepted socket (its executor must be a strand) and the connection's
   /// place under --max-connections (released when the session, or its WebSocket, ends).
@@ -54,6 +58,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
 
   boost::beast::tcp_stream stream_;
   boost::beast::flat_buffer buffer_{kReadBufferLimit};
+  boost::asio::steady_timer refusal_delay_;
   ServerContext& ctx_;
   ConnectionCount::Slot slot_;
   std::string client_;  // The peer's address (the key of its read budget).
