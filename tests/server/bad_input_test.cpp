@@ -325,6 +325,7 @@ const std::vector<Case>& cases() {
          return raw_request(p, raw);
        },
        400, ""},
+      // ---- Routes and methods ----------------------------------------------------------
       {"UnknownRoute", GET("/api/nothing"), 404, ""},
       {"UnknownRoutePost", POST("/api/explode", "{}"), 404, ""},
       {"WrongMethodGetOnPost", GET("/api/reset"), 405, "", "POST"},
