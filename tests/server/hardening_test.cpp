@@ -279,6 +279,21 @@ TEST_F(AllocationFailure, AFailedStepPausesTheSimulationAndResumeGoesOn) {
   EXPECT_EQ(frames, 3);
 }
 
+TEST_F(AllocationFailure, AFailedStepCommandAnswersWhatItDid) {
+  ASSERT_EQ(http_post(port_, "/api/pause").status, 200u);
+  const json before = state();
+  fail_next_ = true;
+  const HttpReply r = http_post(port_, "/api/step", R"({"steps": 10})");
+  ASSERT_EQ(r.status, 200u) << r.body;
+  const json j = r.json();
+  EXPECT_EQ(j["complete"], false);
+  EXPECT_EQ(j["stopped"], "out of memory");
+  EXPECT_EQ(j["steps_done"], 0);
+  EXPECT_EQ(state()["step"], before["step"]);
+  EXPECT_EQ(http_post(port_, "/api/step", R"({"steps": 10})").json()["steps_done"], 10);
+  expect_health_within(port_, 50ms);
+}
+
 TEST_F(AllocationFailure, AThrowingIoHandlerCostsNoThread) {
   for (int i = 0; i < 8; ++i)
     net::post(server_->io_context(), [] { throw std::bad_alloc(); });
