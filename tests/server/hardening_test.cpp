@@ -111,7 +111,9 @@ TEST_P(ChunkMetadata, EndlessMetadataCostsBoundedMemory) {
             << growth / 1024 << " KiB, answer " << r.status << "\n";
   EXPECT_EQ(r.status, 400u) << r.error.message();
   EXPECT_EQ(r.json()["field"], "") << r.body;
-  EXPECT_LT(growth, 16 << 20) << "the server kept what it was sent";
+  // Kept, the 64 MiB would be ≥ 64 MiB of buffer. Release: ~0 growth; under ASan ~15 MiB of
+  // allocator quarantine and shadow in this (shared) process.
+  EXPECT_LT(growth, 32 << 20) << "the server kept what it was sent";
   expect_health_within(port_, 50ms);
 }
 

@@ -129,6 +129,14 @@ double cpu_seconds(pid_t pid) {
 // loop retried at once: 114 % CPU and a log line per failure. Now it waits 100 ms between
 // tries and logs once a second; once the clients leave, it serves again.
 TEST(Main, OutOfDescriptorsTheAcceptLoopBacksOff) {
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+  // Sanitizer runtimes need descriptors of their own: UBSan's vptr check probes memory through
+  // a pipe, fails with EMFILE and reports an "invalid vptr" that is not there (seen under the
+  // asan preset). This is a release-build test.
+  GTEST_SKIP() << "out of descriptors, the sanitizer runtime itself fails";
+#endif
+#endif
   ChildProcess server({"/bin/sh", "-c", "ulimit -n 48 && exec \"$0\" --port 0 --max-connections 1000",
                        TUMBLE_SERVER_BINARY});
   const std::uint16_t port = port_from(server.line());
