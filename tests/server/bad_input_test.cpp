@@ -306,8 +306,8 @@ const std::vector<Case>& cases() {
       {"ChunkExtensionTooLong",
        [](std::uint16_t p) {
          return raw_request(p, "POST /api/step HTTP/1.1\r\nHost: x\r\n"
-                               "Transfer-Encoding: chunked\r\n\r\n1;" +
-                                   std::string(300, 'e') + "\r\n{\r\n0\r\n\r\n");
+                               "Transfer-Encoding: chunked\r\n\r\nc;" +
+                                   std::string(300, 'e') + "\r\n{\"steps\": 1}\r\n0\r\n\r\n");
        },
        400, ""},
       {"ChunkHeaderOverReadBuffer",
