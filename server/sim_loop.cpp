@@ -78,10 +78,11 @@ void SimLoop::run() {
   for (Command& c : queue_.drain()) complete(c, command_error(503, "shutting down", ""));
 }
 
-// An allocation failure inside a step leaves the world as that step left it: the loop
-// pauses (so the failure is not retried 240 times a second), keeps the last published
-// snapshot's poses for viewers, logs once and counts it; POST /api/resume tries again,
-// POST /api/reset starts afresh.
+// An allocation failure inside a step leaves the world as that step left it (World::step is
+// not transactional, and a copy of the last good world would cost a World copy per step):
+// the loop pauses (so the failure is not retried every step), publishes that world as
+// paused, logs once and counts it; POST /api/resume tries again, POST /api/reset starts
+// afresh. If even the snapshot cannot be allocated, the previous one stays published.
 void SimLoop::on_step_failure(const std::exception& e) {
   metrics_.count_step_failure();
   std::fprintf(stderr, "tumble-server: simulation step failed: %s (paused)\n", e.what());
@@ -89,7 +90,6 @@ void SimLoop::on_step_failure(const std::exception& e) {
   try {
     publish(Change::command);
   } catch (const std::exception&) {
-    // Not even the snapshot fits: the previous one stays published.
   }
 }
 
