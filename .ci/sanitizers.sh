@@ -49,10 +49,10 @@ run_preset() {
   ctest --preset "${preset}" -j1 -L server -E "${EXCLUDE}"
 }
 
-run_preset asan engine_tests server_tests tumble-server scene_fuzz rest_fuzz frame_fuzz
+run_preset asan engine_tests server_tests tumble-server scene_fuzz rest_fuzz frame_fuzz chunked_fuzz
 run_preset tsan engine_tests server_tests tumble-server
 
-for target in scene rest frame; do
+for target in scene rest frame chunked; do
   stamp "fuzz: ${target}_fuzz for ${FUZZ_SECONDS} s"
   work=$(mktemp -d)
   cp tests/fuzz/corpus/${target}/* "${work}/"

@@ -3,6 +3,7 @@
 /// server. Every member outlives every session; each is thread-safe.
 #include <filesystem>
 
+#include "admission.hpp"
 #include "broadcaster.hpp"
 #include "metrics.hpp"
 #include "options.hpp"
@@ -17,6 +18,9 @@ struct ServerContext {
   SimLoop& sim;                      ///< Commands go here; snapshots come from here.
   Broadcaster& broadcaster;          ///< Viewers join here.
   Metrics& metrics;                  ///< Counters.
+  ConnectionCount& connections;      ///< Open connections against --max-connections.
+  ReadBudget& read_budget;           ///< Per-client budget of /api/state and /api/scene.
+  int web_root_fd = -1;              ///< The web root opened O_PATH (static files open beneath it).
 };
 
 }  // namespace tumble::server

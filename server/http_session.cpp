@@ -2,7 +2,11 @@
 
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
 #include <boost/beast/websocket.hpp>
+
+#include <cstdio>
+#include <new>
 
 #include "log.hpp"
 #include "static_files.hpp"
@@ -22,20 +26,88 @@ void common_headers(http::response<Body>& res) {
   res.set("X-Content-Type-Options", "nosniff");
 }
 
-// A bare error answered before a request could be parsed (no request to mirror).
-Response early_error(unsigned status, std::string_view message) {
+// An error that ends the connection: answered before (or instead of) reading the request's
+// body, so nothing after it on the connection may be read as another request.
+Response closing_error(unsigned status, std::string_view message, std::string_view field) {
   Response res{static_cast<http::status>(status), 11};
   res.set(http::field::content_type, "application/json");
   res.keep_alive(false);
-  res.body() = nlohmann::json{{"error", message}, {"field", ""}}.dump();
+  res.body() = nlohmann::json{{"error", message}, {"field", field}}.dump();
   res.prepare_payload();
   return res;
 }
 
+// RFC 6455 §4.1: the key is the base64 of 16 bytes: 22 alphabet characters, the last of which
+// carries 2 bits and 4 zero bits (so one of A, Q, g, w), then "==".
+bool valid_websocket_key(std::string_view key) {
+  while (!key.empty() && (key.front() == ' ' || key.front() == '\t')) key.remove_prefix(1);
+  while (!key.empty() && (key.back() == ' ' || key.back() == '\t')) key.remove_suffix(1);
+  if (key.size() != 24 || key.substr(22) != "==") return false;
+  for (std::size_t i = 0; i < 22; ++i) {
+    const char c = key[i];
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '+' && c != '/') return false;
+  }
+  return std::string_view("AQgw").find(key[21]) != std::string_view::npos;
+}
+
+// `text` with %XX escapes and '+' (form encoding, as URLSearchParams writes a space) decoded;
+// a malformed escape is kept as it is (it then matches no token).
+std::string form_decode(std::string_view text) {
+  const auto hex = [](char c) {
+    return std::isxdigit(static_cast<unsigned char>(c))
+               ? (std::isdigit(static_cast<unsigned char>(c)) ? c - '0' : (c | 0x20) - 'a' + 10)
+               : -1;
+  };
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '+') {
+      out += ' ';
+    } else if (text[i] == '%' && i + 2 < text.size() && hex(text[i + 1]) >= 0 &&
+               hex(text[i + 2]) >= 0) {
+      out += static_cast<char>(hex(text[i + 1]) * 16 + hex(text[i + 2]));
+      i += 2;
+    } else {
+      out += text[i];
+    }
+  }
+  return out;
+}
+
+// The query parameter `name` of `target` (still encoded), "" when absent.
+std::string_view query_parameter(std::string_view target, std::string_view name) {
+  const std::size_t q = target.find('?');
+  if (q == std::string_view::npos) return {};
+  std::string_view query = target.substr(q + 1);
+  while (!query.empty()) {
+    const std::size_t amp = query.find('&');
+    const std::string_view pair = query.substr(0, amp);
+    if (pair.size() > name.size() && pair.starts_with(name) && pair[name.size()] == '=')
+      return pair.substr(name.size() + 1);
+    if (amp == std::string_view::npos) break;
+    query.remove_prefix(amp + 1);
+  }
+  return {};
+}
+
+bool costly_read(const Request& req) {
+  if (req.method() != http::verb::get && req.method() != http::verb::head) return false;
+  const std::string_view target = req.target();
+  const std::string_view path = target.substr(0, target.find_first_of("?#"));
+  return path == "/api/state" || path == "/api/scene";
+}
+
 }  // namespace
 
-HttpSession::HttpSession(net::ip::tcp::socket&& socket, ServerContext& ctx)
-    : stream_(std::move(socket)), ctx_(ctx) {}
+HttpSession::HttpSession(net::ip::tcp::socket&& socket, ServerContext& ctx,
+                         ConnectionCount::Slot slot)
+    : stream_(std::move(socket)),
+      refusal_delay_(stream_.get_executor()),
+      ctx_(ctx),
+      slot_(std::move(slot)) {
+  beast::error_code ec;
+  const auto peer = stream_.socket().remote_endpoint(ec);
+  if (!ec) client_ = peer.address().to_string();
+}
 
 void HttpSession::run() {
   net::dispatch(stream_.get_executor(),
@@ -44,35 +116,82 @@ void HttpSession::run() {
 
 void HttpSession::do_read() {
   parser_.emplace();
-  parser_->body_limit(kBodyLimit);
-  parser_->header_limit(kHeaderLimit);
+  limit_parser(*parser_);
   stream_.expires_after(kIdleTimeout);
+  http::async_read_header(stream_, buffer_, *parser_,
+                          beast::bind_front_handler(&HttpSession::on_header, shared_from_this()));
+}
+
+// The header is checked before any body is read: a refused framing is answered and the
+// connection closed, so the body can never be parsed as a request of its own.
+void HttpSession::on_header(beast::error_code ec, std::size_t) {
+  if (ec) return on_read_error(ec);
+  const auto& header = parser_->get();
+  if (const std::optional<FramingRefusal> r = check_framing(header))
+    return refuse(r->status, r->message, r->field);
+  if (parser_->is_done()) return on_read({}, 0);
+  if (!expects_continue(header)) return do_read_body();
+  static constexpr std::string_view kContinue = "HTTP/1.1 100 Continue\r\n\r\n";
+  net::async_write(stream_, net::buffer(kContinue.data(), kContinue.size()),
+                   [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                     if (ec) return self->do_close();
+                     self->do_read_body();
+                   });
+}
+
+void HttpSession::do_read_body() {
   http::async_read(stream_, buffer_, *parser_,
                    beast::bind_front_handler(&HttpSession::on_read, shared_from_this()));
 }
 
 void HttpSession::on_read(beast::error_code ec, std::size_t) {
+  if (ec) return on_read_error(ec);
+  try {
+    handle(parser_->release());
+  } catch (const std::exception& e) {  // e.g. std::bad_alloc: this connection ends, not the server.
+    std::fprintf(stderr, "tumble-server: request handling: %s (connection closed)\n", e.what());
+    do_close();
+  }
+}
+
+void HttpSession::on_read_error(beast::error_code ec) {
   if (ec == http::error::end_of_stream) return do_close();
-  if (ec == http::error::body_limit)
-    return send(early_error(413, "request body over 1 MiB"));
-  if (ec == http::error::header_limit)
-    return send(early_error(431, "request headers too large"));
+  if (ec == http::error::body_limit) return refuse(413, "request body over 1 MiB", "");
+  if (ec == http::error::header_limit) return refuse(431, "request headers too large", "");
+  if (ec == http::error::buffer_overflow)
+    return refuse(400, "request metadata (chunk header or trailer) over 32 KiB", "");
+  if (ec == http::error::bad_chunk_extension)
+    return refuse(400, "chunk extension malformed or over 256 bytes", "");
   if (ec == net::error::operation_aborted || ec == beast::error::timeout ||
       ec == net::error::eof || ec == net::error::connection_reset)
     return do_close();
-  if (ec && ec.category() == http::make_error_code(http::error::bad_target).category())
-    return send(early_error(400, "malformed HTTP request"));
-  if (ec) {
-    fail(ec, "http read");
-    return do_close();
-  }
-  handle(parser_->release());
+  if (ec.category() == http::make_error_code(http::error::bad_target).category())
+    return refuse(400, "malformed HTTP request", "");
+  fail(ec, "http read");
+  do_close();
+}
+
+void HttpSession::refuse(unsigned status, std::string_view message, std::string_view field) {
+  send(closing_error(status, message, field));
 }
 
 void HttpSession::handle(Request&& req) {
   if (beast::websocket::is_upgrade(req)) return upgrade(std::move(req));
   if (is_api_target(req.target())) {
     const bool head = req.method() == http::verb::head;
+    if (costly_read(req)) {
+      const double cost = 1.0 + static_cast<double>(ctx_.sim.latest()->bodies->size());
+      if (const int wait = ctx_.read_budget.admit(client_, cost)) {
+        Response res = error_response(req, 429, "read budget of this client spent", "");
+        res.set(http::field::retry_after, std::to_string(wait));
+        refusal_delay_.expires_after(kRefusalDelay);
+        refusal_delay_.async_wait([self = shared_from_this(), head,
+                                   res = std::move(res)](beast::error_code) mutable {
+          self->reply_later(head, std::move(res));
+        });
+        return;
+      }
+    }
     handle_api(req, ctx_, [self = shared_from_this(), head](Response res) {
       self->reply_later(head, std::move(res));
     });
@@ -85,23 +204,36 @@ void HttpSession::handle(Request&& req) {
 void HttpSession::reply_later(bool head, Response res) {
   net::post(stream_.get_executor(), [self = shared_from_this(), head,
                                      res = std::move(res)]() mutable {
-    if (!head) return self->send(std::move(res));
-    http::response<http::empty_body> bare{res.result(), res.version()};
-    for (const auto& field : res) bare.set(field.name_string(), field.value());
-    bare.keep_alive(res.keep_alive());
-    self->send(std::move(bare));
+    try {
+      if (!head) return self->send(std::move(res));
+      http::response<http::empty_body> bare{res.result(), res.version()};
+      for (const auto& field : res) bare.set(field.name_string(), field.value());
+      bare.keep_alive(res.keep_alive());
+      self->send(std::move(bare));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "tumble-server: reply: %s (connection closed)\n", e.what());
+      self->do_close();
+    }
   });
 }
 
 void HttpSession::upgrade(Request&& req) {
   const std::string_view path = req.target().substr(0, req.target().find('?'));
   if (path != "/ws") return send(error_response(req, 404, "no WebSocket at this path", ""));
+  if (!valid_websocket_key(req[http::field::sec_websocket_key]))
+    return refuse(400, "Sec-WebSocket-Key must be the base64 of 16 bytes", "Sec-WebSocket-Key");
   if (!origin_allowed(req, ctx_.options))
     return send(error_response(req, 403, "WebSocket from this origin is not allowed", "Origin"));
+  if (ctx_.options.token_reads && !authorised(req, ctx_.options) &&
+      !token_matches(form_decode(query_parameter(req.target(), "access_token")),
+                     ctx_.options.token))
+    return send(error_response(req, 401, "missing or wrong token", "Authorization"));
   if (ctx_.broadcaster.viewers() >= static_cast<std::size_t>(ctx_.options.max_viewers))
     return send(error_response(req, 503, "too many viewers", ""));
   stream_.expires_never();
-  std::make_shared<WsSession>(stream_.release_socket(), ctx_.broadcaster, ctx_.metrics)
+  std::make_shared<WsSession>(stream_.release_socket(), ctx_.broadcaster, ctx_.metrics,
+                              std::chrono::milliseconds(ctx_.options.viewer_timeout_ms),
+                              std::move(slot_))
       ->run(std::move(req));
 }
 
@@ -113,7 +245,13 @@ void HttpSession::serve_file(const Request& req) {
   }
   if (req.target().substr(0, req.target().find('?')) == "/ws")
     return send(error_response(req, 426, "use a WebSocket upgrade at /ws", ""));
-  const StaticLookup found = resolve_static(ctx_.web_root, req.target());
+  StaticLookup found = resolve_static(ctx_.web_root, req.target());
+  beast::file file;
+  if (found.status == 200) {
+    const OpenedFile opened = open_beneath(ctx_.web_root_fd, found.relative);
+    found.status = opened.status;
+    if (opened.fd >= 0) file.native_handle(opened.fd);
+  }
   if (found.status != 200) {
     const char* why = found.status == 403   ? "path refused"
                       : found.status == 400 ? "malformed path"
@@ -121,10 +259,10 @@ void HttpSession::serve_file(const Request& req) {
     return send(error_response(req, found.status, why, ""));
   }
   beast::error_code ec;
-  http::file_body::value_type file;
-  file.open(found.file.c_str(), beast::file_mode::scan, ec);
+  http::file_body::value_type body;
+  body.reset(std::move(file), ec);
   if (ec) return send(error_response(req, 404, "not found", ""));
-  const std::uint64_t size = file.size();
+  const std::uint64_t size = body.size();
   const std::string_view type = mime_type(found.file);
   if (req.method() == http::verb::head) {
     http::response<http::empty_body> res{http::status::ok, req.version()};
@@ -134,7 +272,7 @@ void HttpSession::serve_file(const Request& req) {
     res.keep_alive(req.keep_alive());
     return send(std::move(res));
   }
-  http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(file)),
+  http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body)),
                                       std::make_tuple(http::status::ok, req.version())};
   res.set(http::field::content_type, type);
   res.set(http::field::cache_control, "no-cache");
@@ -171,7 +309,7 @@ void HttpSession::on_write(bool close, beast::error_code ec, std::size_t) {
 
 void HttpSession::do_drain() {
   buffer_.consume(buffer_.size());
-  stream_.async_read_some(buffer_.prepare(64 * 1024),
+  stream_.async_read_some(buffer_.prepare(buffer_.max_size()),
                           [self = shared_from_this()](beast::error_code ec, std::size_t) {
                             if (ec) return self->do_close();
                             self->do_drain();

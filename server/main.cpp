@@ -1,5 +1,6 @@
 /// tumble-server: serves the viewer, the REST API and the WebSocket stream of one simulation.
-/// Exit codes: 0 after SIGINT/SIGTERM (or --help), 1 when it cannot listen, 2 for bad input.
+/// Exit codes: 0 after SIGINT/SIGTERM/SIGHUP (or --help), 1 when it cannot listen, 2 for bad
+/// input. SIGPIPE is ignored: a closed stdout/stderr pipe makes a write fail, not the process.
 #include <csignal>
 #include <cstdio>
 #include <iostream>
@@ -12,6 +13,7 @@
 
 int main(int argc, char* argv[]) {
   using namespace tumble::server;
+  std::signal(SIGPIPE, SIG_IGN);  // First, before anything can write to a closed pipe.
   const ParsedOptions parsed = parse_options(argc, argv);
   if (!parsed.options) {
     (parsed.exit_code == 0 ? std::cout : std::cerr) << parsed.message << std::flush;
@@ -37,6 +39,7 @@ int main(int argc, char* argv[]) {
   sigemptyset(&signals);
   sigaddset(&signals, SIGINT);
   sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGHUP);  // The terminal went away: the same graceful stop.
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
   try {

@@ -74,6 +74,9 @@ std::string Metrics::render(const Snapshot& s, std::size_t viewers) const {
   counter(out, "tumble_dropped_sim_seconds_total",
           "Simulated time skipped because stepping fell behind real time.",
           dropped_time_.load(std::memory_order_relaxed));
+  counter(out, "tumble_step_failures_total",
+          "Steps or commands that failed to allocate memory (the simulation paused).",
+          static_cast<double>(step_failures()));
   out << "# HELP tumble_http_responses_total HTTP responses by status class.\n"
          "# TYPE tumble_http_responses_total counter\n";
   for (std::size_t c = 1; c < http_by_class_.size(); ++c)

@@ -29,6 +29,10 @@ class Metrics {
   std::uint64_t frames_sent() const { return frames_sent_.load(std::memory_order_relaxed); }
   /// Frames dropped so far (all sessions).
   std::uint64_t frames_dropped() const { return frames_dropped_.load(std::memory_order_relaxed); }
+  /// A step or command failed to allocate memory (simulation thread).
+  void count_step_failure() { step_failures_.fetch_add(1, std::memory_order_relaxed); }
+  /// Allocation failures so far.
+  std::uint64_t step_failures() const { return step_failures_.load(std::memory_order_relaxed); }
   /// A request was answered with `status`.
   void count_http(unsigned status);
 
@@ -42,6 +46,7 @@ class Metrics {
   std::atomic<double> dropped_time_{0.0};
   std::atomic<std::uint64_t> frames_sent_{0};
   std::atomic<std::uint64_t> frames_dropped_{0};
+  std::atomic<std::uint64_t> step_failures_{0};
   std::array<std::atomic<std::uint64_t>, 6> http_by_class_{};  // 0xx..5xx
 };
 

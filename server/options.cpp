@@ -29,7 +29,17 @@ po::options_description describe() {
        "bearer token required on POST requests (empty: none)")
       ("max-viewers", po::value<int>()->default_value(64), "most WebSocket viewers (1-10000)")
       ("allowed-origin", po::value<std::string>()->default_value(""),
-       "browser Origin allowed besides the server's own ('*': any)");
+       "browser Origin allowed besides the server's own ('*': any)")
+      ("token-reads", po::value<bool>()->default_value(false)->implicit_value(true),
+       "with --token: also require it on GETs (but /api/health) and on /ws")
+      ("max-connections", po::value<int>()->default_value(512),
+       "most open connections, HTTP and WebSocket (1-100000); beyond: 503")
+      ("step-budget-ms", po::value<int>()->default_value(5000),
+       "wall-time budget of one POST /api/step, ms (10-600000)")
+      ("viewer-timeout-ms", po::value<int>()->default_value(15000),
+       "drop a viewer that answers no ping for this long, ms (1000-600000)")
+      ("read-budget", po::value<double>()->default_value(20000),
+       "body records per second per client address for /api/state and /api/scene (0: off)");
   return d;
 }
 
@@ -92,6 +102,20 @@ ParsedOptions parse_options(int argc, const char* const argv[]) {
   if (o.max_viewers < 1 || o.max_viewers > 10000)
     return bad("--max-viewers must be in 1..10000", d);
   o.allowed_origin = vm["allowed-origin"].as<std::string>();
+  o.token_reads = vm["token-reads"].as<bool>();
+  if (o.token_reads && o.token.empty()) return bad("--token-reads needs --token", d);
+  o.max_connections = vm["max-connections"].as<int>();
+  if (o.max_connections < 1 || o.max_connections > 100000)
+    return bad("--max-connections must be in 1..100000", d);
+  o.step_budget_ms = vm["step-budget-ms"].as<int>();
+  if (o.step_budget_ms < 10 || o.step_budget_ms > 600000)
+    return bad("--step-budget-ms must be in 10..600000", d);
+  o.viewer_timeout_ms = vm["viewer-timeout-ms"].as<int>();
+  if (o.viewer_timeout_ms < 1000 || o.viewer_timeout_ms > 600000)
+    return bad("--viewer-timeout-ms must be in 1000..600000", d);
+  o.read_budget = vm["read-budget"].as<double>();
+  if (!(o.read_budget >= 0.0 && o.read_budget <= 1e9))
+    return bad("--read-budget must be in 0..1e9", d);
   if (o.scene.empty()) return bad("--scene must not be empty", d);
   return {o, 0, {}};
 }

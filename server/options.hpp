@@ -18,6 +18,11 @@ struct ServerOptions {
   std::string token;                   ///< Bearer token for POSTs; empty: none required.
   int max_viewers = 64;                ///< Most WebSocket viewers at once.
   std::string allowed_origin;          ///< Origin allowed besides the server's own; "*": any.
+  bool token_reads = false;            ///< --token also on GETs (but /api/health) and /ws.
+  int max_connections = 512;           ///< Most open connections (HTTP + WebSocket) at once.
+  int step_budget_ms = 5000;           ///< Wall-time budget of one POST /api/step, ms.
+  int viewer_timeout_ms = 15000;       ///< A viewer that answers no ping this long is dropped, ms.
+  double read_budget = 20000;          ///< Body records/s per client for /api/state, /api/scene.
 };
 
 /// Result of parsing: options, or an exit code with the text to print.

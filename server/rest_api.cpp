@@ -4,6 +4,7 @@
 #include <cmath>
 #include <initializer_list>
 
+#include "request_limits.hpp"
 #include "tumble/scene_io.hpp"
 
 namespace tumble::server {
@@ -46,6 +47,12 @@ Response ok(const Request& req, const json& body) {
 
 json parse_body(const Request& req) {
   const std::string& body = req.body();
+  // A raw NUL is never valid JSON, but nlohmann's lexer takes it for the end of the input:
+  // "{}\0garbage" would pass.
+  if (body.find('\0') != std::string::npos)
+    throw Refusal{400, "malformed JSON: NUL byte in the body", ""};
+  if (json_too_deep(body))
+    throw Refusal{400, "JSON nested deeper than " + std::to_string(kJsonDepthLimit), ""};
   if (std::all_of(body.begin(), body.end(), [](unsigned char c) { return std::isspace(c); }))
     return json::object();
   json j;
@@ -63,7 +70,7 @@ json parse_body(const Request& req) {
 void only_keys(const json& j, std::initializer_list<std::string_view> keys) {
   for (const auto& [key, value] : j.items())
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
-      throw Refusal{400, "unknown field '" + key + "'", key};
+      throw Refusal{400, "unknown field '" + quoted_prefix(key) + "'", quoted_prefix(key)};
 }
 
 const json& required(const json& j, const char* key) {
@@ -111,7 +118,7 @@ Scene scene_from_request(const json& scene) {
     const std::string name = scene.get<std::string>();
     const std::vector<std::string> names = bundled_scene_names();
     if (std::find(names.begin(), names.end(), name) == names.end())
-      throw Refusal{404, "no bundled scene named '" + name + "'", "scene"};
+      throw Refusal{404, "no bundled scene named '" + quoted_prefix(name) + "'", "scene"};
     try {
       return load_scene(name);
     } catch (const SceneParseError& e) {
@@ -121,9 +128,14 @@ Scene scene_from_request(const json& scene) {
   if (!scene.is_object())
     throw Refusal{400, "expected a bundled scene name or a scene object", "scene"};
   try {
-    return scene_from_json(scene);
-  } catch (const SceneParseError& e) {
-    throw Refusal{400, e.what(), prefixed(e.field)};
+    Scene parsed = scene_from_json(scene);
+    if (parsed.world.dt < kMinDt)
+      throw Refusal{400, "dt must be at least 1e-6 s", "scene.dt"};
+    return parsed;
+  } catch (const Refusal&) {
+    throw;
+  } catch (const SceneParseError& e) {  // Its message and field may quote a client's key.
+    throw Refusal{400, quoted_prefix(e.what(), 160), quoted_prefix(prefixed(e.field), 96)};
   } catch (const std::exception& e) {
     throw Refusal{400, e.what(), "scene"};
   }
@@ -137,11 +149,18 @@ void post_reset(const Request& req, ServerContext& ctx, const Reply& reply) {
   submit(ctx, req, std::move(c), reply);
 }
 
+// The protocol says these bodies are empty: anything else is a client that meant something.
+void require_empty_body(const Request& req) {
+  if (!req.body().empty()) throw Refusal{400, "this request takes no body", ""};
+}
+
 void post_pause(const Request& req, ServerContext& ctx, const Reply& reply) {
+  require_empty_body(req);
   submit(ctx, req, PauseCommand{}, reply);
 }
 
 void post_resume(const Request& req, ServerContext& ctx, const Reply& reply) {
+  require_empty_body(req);
   submit(ctx, req, ResumeCommand{}, reply);
 }
 
@@ -181,7 +200,9 @@ void post_integrator(const Request& req, ServerContext& ctx, const Reply& reply)
   const json& name = required(body, "integrator");
   if (!name.is_string()) throw Refusal{400, "integrator must be a string", "integrator"};
   const std::optional<Integrator> i = parse_integrator(name.get<std::string>());
-  if (!i) throw Refusal{400, "unknown integrator '" + name.get<std::string>() + "'", "integrator"};
+  if (!i)
+    throw Refusal{400, "unknown integrator '" + quoted_prefix(name.get<std::string>()) + "'",
+                  "integrator"};
   submit(ctx, req, SetIntegratorCommand{*i}, reply);
 }
 
@@ -228,7 +249,20 @@ constexpr Route kRoutes[] = {
 
 // ---- Access checks ---------------------------------------------------------------------
 
-// Compares in time that depends only on the expected token's length.
+// The Access-Control-Allow-Origin value for this request ("" for none).
+std::string cors_origin(const Request& req, const ServerOptions& options) {
+  const std::string_view origin = req[http::field::origin];
+  if (origin.empty() || options.allowed_origin.empty()) return {};
+  if (options.allowed_origin != "*" && origin != options.allowed_origin) return {};
+  return std::string(origin);
+}
+
+std::string_view path_of(std::string_view target) {
+  return target.substr(0, target.find_first_of("?#"));
+}
+
+}  // namespace
+
 bool token_matches(std::string_view given, std::string_view expected) {
   unsigned char diff = given.size() == expected.size() ? 0 : 1;
   for (std::size_t i = 0; i < expected.size(); ++i)
@@ -246,20 +280,6 @@ bool authorised(const Request& req, const ServerOptions& options) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return scheme == kScheme && token_matches(auth.substr(kScheme.size()), options.token);
 }
-
-// The Access-Control-Allow-Origin value for this request ("" for none).
-std::string cors_origin(const Request& req, const ServerOptions& options) {
-  const std::string_view origin = req[http::field::origin];
-  if (origin.empty() || options.allowed_origin.empty()) return {};
-  if (options.allowed_origin != "*" && origin != options.allowed_origin) return {};
-  return std::string(origin);
-}
-
-std::string_view path_of(std::string_view target) {
-  return target.substr(0, target.find_first_of("?#"));
-}
-
-}  // namespace
 
 bool is_api_target(std::string_view target) {
   const std::string_view path = path_of(target);
@@ -304,7 +324,7 @@ void handle_api(const Request& req, ServerContext& ctx, Reply reply) {
       route = &r;
   }
   try {
-    if (allow.empty()) throw Refusal{404, "no such route: " + std::string(path), ""};
+    if (allow.empty()) throw Refusal{404, "no such route: " + quoted_prefix(path), ""};
     if (req.method() == http::verb::options && !options.allowed_origin.empty()) {
       Response res{http::status::no_content, req.version()};
       res.set(http::field::allow, allow);
@@ -320,15 +340,17 @@ void handle_api(const Request& req, ServerContext& ctx, Reply reply) {
       res.set(http::field::allow, allow);
       return answer(std::move(res));
     }
-    if (route->method == http::verb::post) {
+    const bool guarded = route->method == http::verb::post ||
+                         (options.token_reads && route->path != "/api/health");
+    if (guarded) {
       if (!authorised(req, options)) {
         Response res = error_response(req, 401, "missing or wrong bearer token", "Authorization");
         res.set(http::field::www_authenticate, "Bearer realm=\"tumble\"");
         return answer(std::move(res));
       }
-      if (!origin_allowed(req, options))
-        throw Refusal{403, "requests from this origin are not allowed", "Origin"};
     }
+    if (route->method == http::verb::post && !origin_allowed(req, options))
+      throw Refusal{403, "requests from this origin are not allowed", "Origin"};
     route->handler(req, ctx, answer);
   } catch (const Refusal& r) {
     answer(error_response(req, r.status, r.message, r.field));

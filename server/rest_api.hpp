@@ -23,6 +23,16 @@ bool is_api_target(std::string_view path);
 /// browser), the server's own origin (http://<Host>), or --allowed-origin ("*": any).
 bool origin_allowed(const Request& request, const ServerOptions& options);
 
+/// True when `given` equals `expected`, in time that depends only on `expected`'s length.
+bool token_matches(std::string_view given, std::string_view expected);
+
+/// True when no --token is set or the request carries "Authorization: Bearer <token>".
+bool authorised(const Request& request, const ServerOptions& options);
+
+/// Shortest scene dt accepted over REST, s: below it a second of simulated time costs a
+/// million steps or more (a busy loop for nothing).
+inline constexpr double kMinDt = 1e-6;
+
 /// A JSON response {"error": message, "field": field}.
 Response error_response(const Request& request, unsigned status, std::string_view message,
                         std::string_view field);

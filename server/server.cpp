@@ -3,6 +3,9 @@
 #include <boost/asio/ip/address.hpp>
 #include <boost/asio/post.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <cstdio>
 
 #include "listener.hpp"
@@ -24,17 +27,30 @@ std::filesystem::path canonical_root(const std::filesystem::path& root) {
   return p;
 }
 
+// The directory static files are opened beneath (openat2 RESOLVE_BENEATH); -1: none.
+int open_root(const std::filesystem::path& root) {
+  return ::open(root.c_str(), O_PATH | O_DIRECTORY | O_CLOEXEC);
+}
+
 }  // namespace
 
 Server::Server(ServerOptions options, Scene scene)
     : options_(std::move(options)),
-      sim_(std::move(scene), metrics_),
+      connections_(static_cast<std::size_t>(options_.max_connections)),
+      read_budget_(options_.read_budget, options_.read_budget),
+      sim_(std::move(scene), metrics_, std::chrono::milliseconds(options_.step_budget_ms)),
       ioc_(options_.threads),
       broadcaster_(ioc_, sim_, std::chrono::milliseconds(options_.render_ms),
                    static_cast<std::size_t>(options_.max_viewers)),
-      ctx_{options_, canonical_root(options_.web_root), sim_, broadcaster_, metrics_} {}
+      ctx_{options_,  canonical_root(options_.web_root), sim_, broadcaster_, metrics_,
+           connections_, read_budget_} {
+  ctx_.web_root_fd = web_root_fd_ = open_root(ctx_.web_root);
+}
 
-Server::~Server() { stop(); }
+Server::~Server() {
+  stop();
+  if (web_root_fd_ >= 0) ::close(web_root_fd_);
+}
 
 void Server::start() {
   const net::ip::tcp::endpoint endpoint(net::ip::make_address(options_.bind), options_.port);
@@ -43,7 +59,7 @@ void Server::start() {
   listener_->run();
   broadcaster_.start();
   sim_.start();
-  for (int i = 0; i < options_.threads; ++i) threads_.emplace_back([this] { ioc_.run(); });
+  for (int i = 0; i < options_.threads; ++i) threads_.emplace_back([this] { run_io(); });
 }
 
 void Server::stop() {
@@ -62,6 +78,21 @@ void Server::stop() {
   ioc_.stop();
   for (std::thread& t : threads_) t.join();
   threads_.clear();
+}
+
+// A handler that throws (std::bad_alloc) unwinds out of run(); the io_context stays usable
+// and run() is simply called again (Asio's documented pattern). The session whose handler
+// threw has lost its pending operation and is freed: that connection closes, nothing else.
+void Server::run_io() {
+  while (true) {
+    try {
+      ioc_.run();
+      return;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "tumble-server: I/O handler failed: %s (connection dropped)\n",
+                   e.what());
+    }
+  }
 }
 
 std::uint16_t Server::port() const { return listener_ ? listener_->port() : 0; }

@@ -16,6 +16,7 @@
 #include <boost/asio/executor_work_guard.hpp>
 #include <boost/asio/io_context.hpp>
 
+#include "admission.hpp"
 #include "broadcaster.hpp"
 #include "context.hpp"
 #include "metrics.hpp"
@@ -52,12 +53,21 @@ class Server {
   const Metrics& metrics() const { return metrics_; }
   /// Connected viewers.
   std::size_t viewers() const { return broadcaster_.viewers(); }
+  /// Open connections (HTTP and WebSocket).
+  std::size_t connections() const { return connections_.open(); }
+  /// The I/O context (for tests that post work to the I/O threads).
+  boost::asio::io_context& io_context() { return ioc_; }
 
  private:
+  void run_io();
+
   // Destruction runs bottom-up: the listener and broadcaster (timers) go before the
   // io_context, whose destruction frees the sessions; the simulation is stopped in stop().
   ServerOptions options_;
   Metrics metrics_;
+  ConnectionCount connections_;
+  ReadBudget read_budget_;
+  int web_root_fd_ = -1;
   SimLoop sim_;
   boost::asio::io_context ioc_;
   Broadcaster broadcaster_;

@@ -1,6 +1,10 @@
 #include "sim_loop.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <new>
+
+#include "request_limits.hpp"
 
 namespace tumble::server {
 namespace {
@@ -26,8 +30,10 @@ void complete(Command& command, CommandResult result) {
 
 }  // namespace
 
-SimLoop::SimLoop(Scene scene, Metrics& metrics)
-    : metrics_(metrics), world_(std::make_unique<World>(std::move(scene))) {
+SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_command_budget)
+    : metrics_(metrics),
+      world_(std::make_unique<World>(std::move(scene))),
+      step_command_budget_(step_command_budget) {
   new_scene_info();
   anchor(Clock::now());
   publish(Change::restart);
@@ -49,17 +55,47 @@ void SimLoop::run() {
   while (true) {
     for (Command& c : queue_.drain()) execute(c);
     if (queue_.closed()) break;
+    if (running_step_) {
+      continue_step();
+      continue;
+    }
     if (paused_) {
       queue_.wait();  // Paused: sleep until a command arrives; no CPU is used.
       continue;
     }
-    advance();
+    try {
+      advance();
+    } catch (const std::exception& e) {  // std::bad_alloc above all: the process lives on.
+      on_step_failure(e);
+      continue;
+    }
     // Sleep until the wall clock reaches the sim time just computed, or a command arrives.
     queue_.wait_until(anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
                                          std::chrono::duration<double>(
                                              world_->time() - anchor_sim_)));
   }
+  if (running_step_) finish_step("shutdown");
   for (Command& c : queue_.drain()) complete(c, command_error(503, "shutting down", ""));
+}
+
+// An allocation failure inside a step leaves the world as that step left it (World::step is
+// not transactional, and a copy of the last good world would cost a World copy per step):
+// the loop pauses (so the failure is not retried every step), publishes that world as
+// paused, logs once and counts it; POST /api/resume tries again, POST /api/reset starts
+// afresh. If even the snapshot cannot be allocated, the previous one stays published.
+void SimLoop::on_step_failure(const std::exception& e) {
+  metrics_.count_step_failure();
+  std::fprintf(stderr, "tumble-server: simulation step failed: %s (paused)\n", e.what());
+  paused_ = true;
+  try {
+    publish(Change::command);
+  } catch (const std::exception&) {
+  }
+}
+
+void SimLoop::world_step() {
+  if (before_step_) before_step_();
+  world_->step();
 }
 
 void SimLoop::anchor(Clock::time_point now) {
@@ -102,7 +138,7 @@ void SimLoop::step_once() {
   const double wall = seconds(t0 - rtf_samples_.front().first);
   if (wall >= kRtfMinWindow)
     real_time_factor_ = (world_->time() - rtf_samples_.front().second) / wall;
-  world_->step();
+  world_step();
   metrics_.observe_step(seconds(Clock::now() - t0));
   publish(Change::step);
 }
@@ -140,11 +176,25 @@ void SimLoop::publish(Change change) {
 }
 
 void SimLoop::execute(Command& command) {
+  const bool is_step = std::holds_alternative<StepCommand>(command.kind);
+  if (running_step_) {
+    if (is_step)
+      return complete(command, command_error(409, "a step is already running", "steps"));
+    // Pause, resume and reset cancel the running step; impulses and integrator changes
+    // apply between its chunks.
+    if (!std::holds_alternative<ImpulseCommand>(command.kind) &&
+        !std::holds_alternative<SetIntegratorCommand>(command.kind))
+      finish_step("cancelled");
+  }
+  if (is_step) return start_step(command);
   CommandResult result;
   try {
     result = run_command(command.kind);
   } catch (const InvalidInput& e) {
     result = command_error(400, e.what(), "");
+  } catch (const std::bad_alloc&) {
+    metrics_.count_step_failure();
+    result = command_error(503, "out of memory: the command was not applied", "");
   } catch (const std::exception& e) {
     result = command_error(500, e.what(), "");
   }
@@ -153,7 +203,6 @@ void SimLoop::execute(Command& command) {
 
 CommandResult SimLoop::run_command(CommandKind& kind) {
   if (auto* c = std::get_if<ResetCommand>(&kind)) return reset(*c);
-  if (auto* c = std::get_if<StepCommand>(&kind)) return step_paused(*c);
   if (auto* c = std::get_if<ImpulseCommand>(&kind)) return impulse(*c);
   if (auto* c = std::get_if<SetIntegratorCommand>(&kind)) {
     world_->set_integrator(c->integrator);
@@ -179,16 +228,54 @@ CommandResult SimLoop::reset(ResetCommand& c) {
   return {200, {{"ok", true}, {"scene", world_->scene().world.name}}};
 }
 
-CommandResult SimLoop::step_paused(const StepCommand& c) {
-  if (!paused_) return command_error(409, "step is only allowed while paused", "steps");
-  for (std::uint32_t i = 0; i < c.steps; ++i) {
-    if (i % 64 == 63 && queue_.closed()) break;  // Shutting down: don't hold it up.
-    const Clock::time_point t0 = Clock::now();
-    world_->step();
-    metrics_.observe_step(seconds(Clock::now() - t0));
+void SimLoop::start_step(Command& command) {
+  if (!paused_)
+    return complete(command, command_error(409, "step is only allowed while paused", "steps"));
+  const std::uint32_t steps = std::get<StepCommand>(command.kind).steps;
+  running_step_.emplace(
+      RunningStep{std::move(command), steps, 0, Clock::now() + step_command_budget_});
+}
+
+// One chunk of the running step: at most kStepBudget of wall time, then back to the queue.
+void SimLoop::continue_step() {
+  RunningStep& r = *running_step_;
+  const Clock::time_point chunk_end = std::min(Clock::now() + kStepBudget, r.deadline);
+  try {
+    while (r.done < r.requested) {
+      const Clock::time_point t0 = Clock::now();
+      if (t0 >= chunk_end) break;
+      world_step();
+      metrics_.observe_step(seconds(Clock::now() - t0));
+      ++r.done;
+    }
+  } catch (const std::exception& e) {
+    metrics_.count_step_failure();
+    std::fprintf(stderr, "tumble-server: step command failed: %s\n", e.what());
+    return finish_step("out of memory");
   }
-  publish(Change::restart);
-  return {200, {{"ok", true}, {"time", world_->time()}, {"step", world_->step_count()}}};
+  if (r.done == r.requested) return finish_step(nullptr);
+  if (Clock::now() >= r.deadline) return finish_step("budget");
+  publish(Change::restart);  // Viewers see the progress of a long step.
+}
+
+// Answers the running step: complete, or stopped early ("budget", "cancelled", "shutdown",
+// "out of memory") with the steps actually taken. Either way the world is as stepped.
+void SimLoop::finish_step(const char* stopped) {
+  RunningStep r = std::move(*running_step_);
+  running_step_.reset();
+  CommandResult result{200, {{"ok", true}}};
+  try {
+    publish(Change::restart);
+    result.body["time"] = world_->time();
+    result.body["step"] = world_->step_count();
+    result.body["steps_requested"] = r.requested;
+    result.body["steps_done"] = r.done;
+    result.body["complete"] = stopped == nullptr;
+    if (stopped) result.body["stopped"] = stopped;
+  } catch (const std::exception&) {
+    result = command_error(503, "out of memory", "");
+  }
+  complete(r.command, std::move(result));
 }
 
 CommandResult SimLoop::impulse(const ImpulseCommand& c) {
@@ -198,8 +285,23 @@ CommandResult SimLoop::impulse(const ImpulseCommand& c) {
       return command_error(404, "no body with index " + std::to_string(*index), "body");
     id = *index;
   } else if (!world_->find_body(std::get<std::string>(c.body), id)) {
-    return command_error(404, "no body named '" + std::get<std::string>(c.body) + "'", "body");
+    return command_error(404, "no body named '" + quoted_prefix(std::get<std::string>(c.body)) + "'",
+                         "body");
   }
+  // Bounded in total, not only per kick: the body's speed and spin after this impulse.
+  const Body& b = world_->bodies()[id];
+  const Vec3 arm = c.point ? Vec3(*c.point - b.s.x) : Vec3(Vec3::Zero());
+  BodyState after = b.s;
+  after.P += c.impulse;
+  after.L += arm.cross(c.impulse);
+  const double speed = velocity(after, b.c).norm();
+  const double spin = angular_velocity(after, b.c).norm();
+  if (speed > kMaxSpeed && speed > velocity(b.s, b.c).norm())
+    return command_error(400, "the impulse would give the body a speed over 1000 m/s",
+                         "impulse");
+  if (spin > kMaxSpin && spin > angular_velocity(b.s, b.c).norm())
+    return command_error(400, "the impulse would give the body a spin over 1000 rad/s",
+                         "impulse");
   if (c.point)
     world_->apply_impulse(id, c.impulse, *c.point);
   else

@@ -10,6 +10,8 @@
 ///   auto snap = sim.latest();   // any thread
 ///   sim.stop();
 #include <deque>
+#include <functional>
+#include <optional>
 #include <memory>
 #include <mutex>
 #include <thread>
@@ -54,6 +56,11 @@ class SimLoop {
   static constexpr double kMaxCatchUp = 0.1;
   /// Longest the loop steps (wall time) before it looks at the command queue again.
   static constexpr std::chrono::milliseconds kStepBudget{20};
+  /// Fastest linear speed (m/s) an impulse may give a body: a kick past it (that does not
+  /// slow the body) is refused with 400, the world untouched.
+  static constexpr double kMaxSpeed = 1e3;
+  /// Fastest spin (rad/s) an impulse may give a body; the same rule.
+  static constexpr double kMaxSpin = 1e3;
   /// Wall-time window (s) over which the real-time factor is measured.
   static constexpr double kRtfWindow = 2.0;
   /// Shortest window (s) that updates it; until then (after a start, resume or reset) the
@@ -62,7 +69,8 @@ class SimLoop {
 
   /// Builds the world (throws tumble::InvalidInput for an invalid scene) and publishes its
   /// first snapshot. The loop does not run until start().
-  SimLoop(Scene scene, Metrics& metrics);
+  SimLoop(Scene scene, Metrics& metrics,
+          std::chrono::milliseconds step_command_budget = std::chrono::seconds(5));
   /// Stops the thread.
   ~SimLoop();
   SimLoop(const SimLoop&) = delete;
@@ -76,9 +84,21 @@ class SimLoop {
   void submit(Command command) { queue_.push(std::move(command)); }
   /// The latest published snapshot (never null).
   std::shared_ptr<const Snapshot> latest() const { return latest_.load(); }
+  /// Test seam: called on the simulation thread before every World::step; it may throw
+  /// (std::bad_alloc, to check the loop survives it). Set before start().
+  void set_before_step(std::function<void()> hook) { before_step_ = std::move(hook); }
 
  private:
   enum class Change { step, command, restart };
+
+  /// A POST /api/step in progress: taken kStepBudget of wall time at a time, so that
+  /// commands queued behind it run between chunks.
+  struct RunningStep {
+    Command command;
+    std::uint32_t requested = 0;
+    std::uint32_t done = 0;
+    Clock::time_point deadline;
+  };
 
   void run();
   void advance();
@@ -86,7 +106,11 @@ class SimLoop {
   void execute(Command& command);
   CommandResult run_command(CommandKind& kind);
   CommandResult reset(ResetCommand& c);
-  CommandResult step_paused(const StepCommand& c);
+  void start_step(Command& command);
+  void continue_step();
+  void finish_step(const char* stopped);
+  void world_step();
+  void on_step_failure(const std::exception& e);
   CommandResult impulse(const ImpulseCommand& c);
   void anchor(Clock::time_point now);
   double sim_clock(Clock::time_point now) const;
@@ -103,6 +127,9 @@ class SimLoop {
   double anchor_sim_ = 0.0;
   std::deque<std::pair<Clock::time_point, double>> rtf_samples_;  // (wall, sim time)
   double real_time_factor_ = 1.0;
+  const std::chrono::milliseconds step_command_budget_;
+  std::optional<RunningStep> running_step_;
+  std::function<void()> before_step_;
   CommandQueue queue_;
   SnapshotSlot latest_;
   std::thread thread_;

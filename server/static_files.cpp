@@ -1,6 +1,13 @@
 #include "static_files.hpp"
 
+#include <fcntl.h>
+#include <linux/openat2.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <optional>
 #include <string>
 
@@ -59,7 +66,9 @@ StaticLookup resolve_static(const std::filesystem::path& root, std::string_view 
   while (start <= path.size()) {
     const std::size_t end = std::min(path.find('/', start), path.size());
     const std::string_view segment(path.data() + start, end - start);
-    if (segment.empty() || segment == "." || segment == "..") return {403, {}};
+    // Dotfiles (.git, .env …) and the viewer's build-time npm modules are never content.
+    if (segment.empty() || segment.front() == '.' || segment == "node_modules")
+      return {403, {}};
     relative /= fs::path(std::string(segment));
     start = end + 1;
   }
@@ -69,7 +78,52 @@ StaticLookup resolve_static(const std::filesystem::path& root, std::string_view 
   if (ec) return {404, {}};
   if (!inside(root, resolved)) return {403, {}};
   if (!fs::is_regular_file(resolved, ec)) return {404, {}};
-  return {200, resolved};
+  return {200, resolved, resolved.lexically_relative(root)};
+}
+
+namespace {
+
+unsigned status_of(int error) {
+  return error == EXDEV || error == ELOOP || error == EACCES || error == EPERM ? 403u : 404u;
+}
+
+// Where openat2 is missing (Linux < 5.6, or filtered by seccomp): one component at a time,
+// never following a symlink (the same rule as RESOLVE_NO_SYMLINKS).
+int open_without_links(int root_fd, const std::filesystem::path& relative) {
+  int dir = root_fd;
+  int fd = -1;
+  for (auto it = relative.begin(); it != relative.end();) {
+    const std::filesystem::path& part = *it;
+    const bool last = ++it == relative.end();
+    const int flags = last ? O_RDONLY | O_NONBLOCK | O_NOCTTY : O_PATH | O_DIRECTORY;
+    fd = ::openat(dir, part.c_str(), flags | O_NOFOLLOW | O_CLOEXEC);
+    const int error = errno;
+    if (dir != root_fd) ::close(dir);
+    if (fd < 0) {
+      errno = error;
+      return -1;
+    }
+    dir = fd;
+  }
+  return fd;
+}
+
+}  // namespace
+
+OpenedFile open_beneath(int root_fd, const std::filesystem::path& relative) {
+  if (root_fd < 0 || relative.empty()) return {};
+  open_how how{};
+  how.flags = O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC;  // O_NONBLOCK: a FIFO can't hang us.
+  how.resolve = RESOLVE_BENEATH | RESOLVE_NO_SYMLINKS;
+  int fd = static_cast<int>(::syscall(SYS_openat2, root_fd, relative.c_str(), &how, sizeof how));
+  if (fd < 0 && (errno == ENOSYS || errno == EPERM)) fd = open_without_links(root_fd, relative);
+  if (fd < 0) return {-1, status_of(errno)};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return {};
+  }
+  return {fd, 200};
 }
 
 std::string_view mime_type(const std::filesystem::path& file) {

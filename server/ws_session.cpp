@@ -3,6 +3,8 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 
+#include <random>
+
 #include "broadcaster.hpp"
 #include "log.hpp"
 
@@ -12,17 +14,33 @@ namespace beast = boost::beast;
 namespace websocket = beast::websocket;
 namespace net = boost::asio;
 
-WsSession::WsSession(net::ip::tcp::socket&& socket, Broadcaster& broadcaster, Metrics& metrics)
-    : ws_(std::move(socket)), broadcaster_(broadcaster), metrics_(metrics) {}
+WsSession::WsSession(net::ip::tcp::socket&& socket, Broadcaster& broadcaster, Metrics& metrics,
+                     std::chrono::milliseconds timeout, ConnectionCount::Slot slot)
+    : ws_(std::move(socket)),
+      broadcaster_(broadcaster),
+      metrics_(metrics),
+      ping_timer_(ws_.get_executor()),
+      timeout_(timeout),
+      slot_(std::move(slot)) {}
 
 void WsSession::run(beast::http::request<beast::http::string_body> request) {
   // The websocket stream's own timeouts replace the tcp_stream's.
   beast::get_lowest_layer(ws_).expires_never();
   websocket::stream_base::timeout timeout =
       websocket::stream_base::timeout::suggested(beast::role_type::server);
-  timeout.idle_timeout = std::chrono::seconds(30);
-  timeout.keep_alive_pings = true;
+  // Our own pings (do_ping_timer) replace Beast's idle timeout: a peer that sends nothing at
+  // all sends no pong either. (Beast's idle timeout without its keep-alive pings is a hard
+  // deadline from the upgrade on, not an idle one.)
+  timeout.idle_timeout = websocket::stream_base::none();
+  timeout.keep_alive_pings = false;
   ws_.set_option(timeout);
+  ws_.control_callback([this](websocket::frame_type kind, beast::string_view payload) {
+    if (kind == websocket::frame_type::pong && ping_outstanding_ &&
+        payload == beast::string_view(ping_payload_.data(), ping_payload_.size())) {
+      ping_outstanding_ = false;
+      ticks_unanswered_ = 0;
+    }
+  });
   ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& res) {
     res.set(beast::http::field::server, "tumble-server");
   }));
@@ -49,6 +67,39 @@ void WsSession::on_accept(beast::error_code ec) {
   pending_scene_ = scene->message;
   do_write();
   do_read();
+  do_ping_timer();
+}
+
+void WsSession::do_ping_timer() {
+  ping_timer_.expires_after(timeout_ / 2);
+  ping_timer_.async_wait(beast::bind_front_handler(&WsSession::on_ping_timer, shared_from_this()));
+}
+
+// A viewer must show it reads: a ping with a random payload goes out behind the frames
+// already queued, and only a client that read up to it can echo the payload (an unsolicited
+// pong sent blind does not match). Unanswered for two ticks (the timeout): dropped.
+void WsSession::on_ping_timer(beast::error_code ec) {
+  if (ec || finished_ || closing_) return;
+  if (ping_outstanding_) {
+    if (++ticks_unanswered_ >= 2) return drop();
+    return do_ping_timer();
+  }
+  static thread_local std::mt19937_64 random{std::random_device{}()};
+  const std::string nonce = std::to_string(random());
+  ping_payload_.assign(nonce.data(), nonce.size());
+  ping_outstanding_ = true;
+  ticks_unanswered_ = 0;
+  ws_.async_ping(ping_payload_, [self = shared_from_this()](beast::error_code ec) {
+    if (ec) self->finish();
+  });
+  do_ping_timer();
+}
+
+// No close frame: a peer that does not read would never take it.
+void WsSession::drop() {
+  beast::error_code ec;
+  beast::get_lowest_layer(ws_).socket().close(ec);
+  finish();
 }
 
 void WsSession::do_read() {
@@ -132,6 +183,7 @@ void WsSession::do_close() {
 void WsSession::finish() {
   if (finished_) return;
   finished_ = true;
+  ping_timer_.cancel();
   pending_frame_.reset();
   pending_scene_.reset();
   broadcaster_.leave(this);

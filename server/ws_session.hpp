@@ -2,7 +2,10 @@
 /// One WebSocket viewer (/ws). All its work runs on its own strand. It sends the scene text
 /// message first (and again after each reset, before that scene's frames), then binary
 /// frames; at most one frame waits: a newer one replaces it and the drop is counted.
-/// Client messages are read and ignored (over 4 KiB: the connection is closed).
+/// Client messages are read and ignored (over 4 KiB: the connection is closed). Every half
+/// viewer timeout it sends a ping with a random payload; a viewer that has not echoed it in a
+/// pong within the timeout (it does not read, or reads too slowly to reach the ping) is
+/// dropped, so its slot under --max-viewers is freed.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -11,6 +14,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include "admission.hpp"
 #include "metrics.hpp"
 #include "snapshot.hpp"
 
@@ -24,8 +28,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   /// Largest message a client may send, bytes.
   static constexpr std::size_t kMaxClientMessage = 4096;
 
-  /// Takes over an accepted socket (its executor must be a strand).
-  WsSession(boost::asio::ip::tcp::socket&& socket, Broadcaster& broadcaster, Metrics& metrics);
+  /// Takes over an accepted socket (its executor must be a strand); `timeout`: a ping left
+  /// unanswered this long drops the viewer; `slot`: its place under --max-connections.
+  WsSession(boost::asio::ip::tcp::socket&& socket, Broadcaster& broadcaster, Metrics& metrics,
+            std::chrono::milliseconds timeout = std::chrono::seconds(15),
+            ConnectionCount::Slot slot = nullptr);
 
   /// Completes the upgrade of `request` and starts sending.
   void run(boost::beast::http::request<boost::beast::http::string_body> request);
@@ -44,11 +51,20 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void on_write(bool is_frame, boost::beast::error_code ec, std::size_t bytes);
   void do_close();
   void finish();
+  void do_ping_timer();
+  void on_ping_timer(boost::beast::error_code ec);
+  void drop();
 
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
   Broadcaster& broadcaster_;
   Metrics& metrics_;
   boost::beast::flat_buffer read_buffer_;
+  boost::asio::steady_timer ping_timer_;
+  const std::chrono::milliseconds timeout_;
+  ConnectionCount::Slot slot_;
+  boost::beast::websocket::ping_data ping_payload_;  // Expected back in the pong.
+  bool ping_outstanding_ = false;
+  int ticks_unanswered_ = 0;
   std::shared_ptr<const std::string> pending_scene_;  // Text message to send first.
   std::shared_ptr<const std::string> pending_frame_;  // The one waiting frame.
   std::shared_ptr<const std::string> in_flight_;      // Kept alive while being written.

@@ -13,7 +13,7 @@
 #include <boost/beast/http.hpp>
 #include <nlohmann/json.hpp>
 
-#include "http_session.hpp"
+#include "request_limits.hpp"
 #include "rest_api.hpp"
 #include "server.hpp"
 #include "static_files.hpp"
@@ -30,7 +30,10 @@ struct Fixture {
   SimLoop sim{tumble::load_scene("seed"), metrics};
   boost::asio::io_context ioc;
   Broadcaster broadcaster{ioc, sim, std::chrono::milliseconds(20), 4};
-  ServerContext ctx{options, std::filesystem::temp_directory_path(), sim, broadcaster, metrics};
+  ConnectionCount connections{64};
+  ReadBudget read_budget{0, 0};
+  ServerContext ctx{options, std::filesystem::temp_directory_path(), sim, broadcaster, metrics,
+                    connections, read_budget};
   Fixture() {
     options.token = "fuzz-token";
     options.allowed_origin = "http://viewer.example";
@@ -42,9 +45,8 @@ struct Fixture {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static Fixture f;
-  http::request_parser<http::string_body> parser;
-  parser.body_limit(HttpSession::kBodyLimit);
-  parser.header_limit(HttpSession::kHeaderLimit);
+  RequestParser parser;
+  limit_parser(parser);
   parser.eager(true);
   boost::beast::error_code ec;
   parser.put(boost::asio::buffer(data, size), ec);

@@ -96,6 +96,7 @@ struct Case {
   unsigned status;       ///< Expected HTTP status (101: a WebSocket case, no JSON body).
   const char* field;     ///< Expected "field" of the JSON error; nullptr: no JSON body.
   const char* allow = nullptr;  ///< Expected Allow header (405).
+  std::size_t max_body = 0;     ///< When set: the answer's body is at most this long.
 };
 
 HttpReply post(std::uint16_t port, const char* target, std::string body,
@@ -107,6 +108,12 @@ HttpReply post(std::uint16_t port, const char* target, std::string body,
 #define RESET(...) [](std::uint16_t p) { return post(p, "/api/reset", reset_with(__VA_ARGS__)); }
 #define RAW(text) [](std::uint16_t p) { return raw_request(p, text); }
 #define GET(target) [](std::uint16_t p) { return http_get(p, target); }
+#define WS_WITH_KEY(key)                                                                  \
+  "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"     \
+  "Sec-WebSocket-Key: " key "\r\nSec-WebSocket-Version: 13\r\n\r\n"
+#define HIDDEN_PAUSE "POST /api/pause HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\n\r\n"
+#define SMUGGLE(coding)                                                                  \
+  "POST /api/step HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: " coding "\r\n\r\n" HIDDEN_PAUSE
 
 const std::vector<Case>& cases() {
   static const std::vector<Case> table = {
@@ -115,6 +122,23 @@ const std::vector<Case>& cases() {
       {"JsonNotAnObject", POST("/api/step", "[1, 2]"), 400, ""},
       {"JsonBareString", POST("/api/reset", "\"seed\""), 400, ""},
       {"InvalidUtf8", POST("/api/reset", "{\"scene\": \"\xff\xfe\"}"), 400, ""},
+      {"TrailingNul", POST("/api/step", std::string("{\"steps\": 1}\0", 13)), 400, ""},
+      {"MillionBrackets", POST("/api/step", std::string(1000000, '[')), 400, ""},
+      {"JsonDepth33",
+       POST("/api/step", R"({"steps": [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]})"),
+       400, ""},
+      {"PauseWithBody", POST("/api/pause", "{}"), 400, ""},
+      {"ResumeWithBody", POST("/api/resume", "x"), 400, ""},
+      {"HugeUnknownKeyNotEchoed",
+       [](std::uint16_t p) {
+         return post(p, "/api/step", "{\"steps\": 1, \"" + std::string(900000, 'k') + "\": 1}");
+       },
+       400, "kkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkkk…", nullptr, 400},
+      {"HugeUnknownSceneKeyNotEchoed",
+       [](std::uint16_t p) {
+         return post(p, "/api/reset", reset_with([](json& s) { s[std::string(900000, 'k')] = 1; }));
+       },
+       400, nullptr, nullptr, 600},
       {"StepsWrongType", POST("/api/step", R"({"steps": "3"})"), 400, "steps"},
       {"BodyWrongType", POST("/api/impulse", R"({"body": [0], "impulse": [0, 1, 0]})"), 400,
        "body"},
@@ -149,6 +173,17 @@ const std::vector<Case>& cases() {
       {"ImpulseMinusZero", POST("/api/impulse", R"({"body": 0, "impulse": [-0.0, -0, -0.0]})"),
        200, nullptr},
       {"Steps1e308", POST("/api/step", R"({"steps": 1e308})"), 400, "steps"},
+      {"ImpulsePastSpeedLimit", POST("/api/impulse", R"({"body": 0, "impulse": [1e6, 0, 0]})"),
+       400, "impulse"},
+      {"ImpulsePastSpinLimit",
+       POST("/api/impulse", R"({"body": 0, "impulse": [0, 0, 100], "point": [0, 1e3, 0]})"), 400,
+       "impulse"},
+      {"SceneDtTiny",
+       RESET([](json& s) {
+         s["dt"] = 1e-9;  // Valid for the engine (its TOI tolerance below it), but a busy loop.
+         s["toi_tolerance"] = 1e-12;
+       }),
+       400, "scene.dt"},
       {"StepsMinusZero", POST("/api/step", R"({"steps": -0})"), 400, "steps"},
       {"SceneMass1e308", RESET([](json& s) { s["bodies"][0]["mass"] = 1e308; }), 400,
        "scene.bodies[0].mass"},
@@ -246,6 +281,51 @@ const std::vector<Case>& cases() {
       {"GarbageRequestLine", RAW("\x01\x02 garbage\r\n\r\n"), 400, ""},
       {"BadContentLength", RAW("POST /api/pause HTTP/1.1\r\nContent-Length: -4\r\n\r\n"), 400,
        ""},
+      {"Http11WithoutHost", RAW("GET /api/health HTTP/1.1\r\n\r\n"), 400, "Host"},
+      {"TwoHosts", RAW("GET /api/health HTTP/1.1\r\nHost: a\r\nHost: b\r\n\r\n"), 400, "Host"},
+      {"ExpectUnknown",
+       RAW("POST /api/step HTTP/1.1\r\nHost: x\r\nExpect: teapot\r\nContent-Length: 2\r\n\r\n{}"),
+       417, "Expect"},
+      // ---- Request framing: a body must never run as a second request (RFC 9112 §6.3) ----
+      // Each hides a POST /api/pause in the body; the checks after the row find the
+      // simulation still running, so the hidden request never ran.
+      {"TransferEncodingXchunked", RAW(SMUGGLE("xchunked")), 400, "Transfer-Encoding"},
+      {"TransferEncodingIdentity", RAW(SMUGGLE("identity")), 400, "Transfer-Encoding"},
+      {"TransferEncodingGzip", RAW(SMUGGLE("gzip")), 400, "Transfer-Encoding"},
+      {"TransferEncodingChunkedIdentity", RAW(SMUGGLE("chunked, identity")), 400,
+       "Transfer-Encoding"},
+      {"TransferEncodingGzipChunked", RAW(SMUGGLE("gzip, chunked")), 501, "Transfer-Encoding"},
+      {"TransferEncodingTwice",
+       RAW("POST /api/step HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n"
+           "Transfer-Encoding: chunked\r\n\r\n0\r\n\r\n"),
+       400, ""},
+      {"ContentLengthAndTransferEncoding",
+       RAW("POST /api/step HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n"
+           "Transfer-Encoding: chunked\r\n\r\n0\r\n\r\n" HIDDEN_PAUSE),
+       400, ""},
+      {"ChunkExtensionTooLong",
+       [](std::uint16_t p) {
+         return raw_request(p, "POST /api/step HTTP/1.1\r\nHost: x\r\n"
+                               "Transfer-Encoding: chunked\r\n\r\nc;" +
+                                   std::string(300, 'e') + "\r\n{\"steps\": 1}\r\n0\r\n\r\n");
+       },
+       400, ""},
+      {"ChunkHeaderOverReadBuffer",
+       [](std::uint16_t p) {
+         return raw_request(p, "POST /api/step HTTP/1.1\r\nHost: x\r\n"
+                               "Transfer-Encoding: chunked\r\n\r\n1;" +
+                                   std::string(100000, 'e'));
+       },
+       400, ""},
+      {"TrailerOverReadBuffer",
+       [](std::uint16_t p) {
+         std::string raw = "POST /api/step HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n"
+                           "2\r\n{}\r\n0\r\n";
+         for (int i = 0; i < 5000; ++i) raw += "X-T" + std::to_string(i) + ": vvvvvvvvvv\r\n";
+         return raw_request(p, raw);
+       },
+       400, ""},
+      // ---- Routes and methods ----------------------------------------------------------
       {"UnknownRoute", GET("/api/nothing"), 404, ""},
       {"UnknownRoutePost", POST("/api/explode", "{}"), 404, ""},
       {"WrongMethodGetOnPost", GET("/api/reset"), 405, "", "POST"},
@@ -265,6 +345,8 @@ const std::vector<Case>& cases() {
       {"NulInPath", GET("/index.html%00.js"), 403, ""},
       {"BadPercentEscape", GET("/%zz"), 400, ""},
       {"NoDirectoryListing", GET("/empty/"), 404, ""},
+      {"NodeModulesNotServed", GET("/node_modules/pkg/index.js"), 403, ""},
+      {"DotfileNotServed", GET("/.env"), 403, ""},
       // ---- WebSocket ---------------------------------------------------------------------
       {"WsWrongOrigin",
        [](std::uint16_t p) {
@@ -276,6 +358,11 @@ const std::vector<Case>& cases() {
        },
        403, "Origin"},
       {"WsWithoutUpgrade", GET("/ws"), 426, ""},
+      {"WsKeyEmpty", RAW(WS_WITH_KEY("")), 400, "Sec-WebSocket-Key"},
+      {"WsKeyShort", RAW(WS_WITH_KEY("c2hvcnQ=")), 400, "Sec-WebSocket-Key"},
+      {"WsKeyNotBase64", RAW(WS_WITH_KEY("!!!!!!!!!!!!!!!!!!!!!!==")), 400, "Sec-WebSocket-Key"},
+      {"WsKeySeventeenBytes", RAW(WS_WITH_KEY("AAAAAAAAAAAAAAAAAAAAAAA=")), 400,
+       "Sec-WebSocket-Key"},
       {"WsTextGarbage",
        [](std::uint16_t p) { return ws_misbehave(p, ws_frame(0x1, "{\"type\": \"take over\"")); },
        101, nullptr},
@@ -327,6 +414,9 @@ TEST_P(BadInput, RefusedAndNothingLost) {
   }
   if (c.allow) {
     EXPECT_EQ(r.headers[http::field::allow], c.allow);
+  }
+  if (c.max_body) {
+    EXPECT_LE(r.body.size(), c.max_body) << r.body.substr(0, 200);
   }
 
   // Alive, and the same simulation, only further on.

@@ -1,7 +1,11 @@
 /// server_load: a bounded load test of a tumble-server child process on 127.0.0.1.
-///   server_load [--profile full|ci] [--server PATH] [--scene NAME]
+///   server_load [--profile full|ci|hostile] [--server PATH] [--scene NAME]
 /// full: 200 WebSocket viewers that keep up, 1 that never reads, 1000 REST requests/s for
 ///       20 s. ci: 20 viewers, 1 stalled, 200 requests/s for 5 s.
+/// hostile (issue 12): scene pile (1,000 bodies, 364 KB states), 20 viewers and 200 cheap
+///       requests/s as in ci, plus 4 clients looping GET /api/state back to back and 64
+///       squatting sockets (upgrade, one byte every 5 s, never read) that fill every free
+///       viewer slot; --viewer-timeout-ms 4000; a late viewer joins 8 s in and must be fed.
 /// Measures (over the loaded window, after a 2 s warm-up): the real-time factor (min of 1 s
 /// samples of /api/state), the fraction of broadcast frames each reader got (from the frame
 /// numbers), the server's resident memory growth, the mean step time before and under load,
@@ -50,10 +54,14 @@ struct Profile {
   double max_rss_growth_mb;  ///< Server memory growth over the loaded window.
   double max_step_ratio;     ///< Mean step time under load / before.
   double min_rest_share;     ///< REST requests answered 200 / sent.
+  int squatters = 0;         ///< Sockets that upgrade and never read (hostile).
+  int hoggers = 0;           ///< Clients looping the most expensive GET (hostile).
 };
 
 constexpr Profile kFull{200, 1000, 20.0, 0.99, 0.95, 10.0, 3.0, 0.99};
 constexpr Profile kCi{20, 200, 5.0, 0.90, 0.80, 20.0, 5.0, 0.95};
+constexpr Profile kHostile{20, 200, 20.0, 0.98, 0.95, 20.0, 5.0, 0.99, 64, 4};
+constexpr int kViewerTimeoutMs = 4000;  // hostile: squatters are dropped within 1.5 × this.
 constexpr int kRenderMs = 20;
 
 // ---- The server process -----------------------------------------------------------------
@@ -135,6 +143,7 @@ struct Rester : std::enable_shared_from_this<Rester> {
   Clock::time_point next, end;
   std::uint64_t sent = 0, ok = 0, other = 0, errors = 0, late = 0, n = 0;
   bool busy = false;
+  bool cheap_only = false;  // hostile: the expensive reads are the hoggers' part.
   Rester(net::io_context& ioc, std::uint16_t p, Clock::duration per, Clock::time_point e)
       : stream(ioc), timer(ioc), port(p), period(per), end(e) {}
   void start() {
@@ -158,7 +167,7 @@ struct Rester : std::enable_shared_from_this<Rester> {
     if (busy) return void(++late);  // previous answer not back: counts as not answered
     busy = true;
     static const char* kTargets[] = {"/api/state", "/api/health", "/metrics", "/api/scene"};
-    req = {http::verb::get, kTargets[n++ % 4], 11};
+    req = {http::verb::get, kTargets[cheap_only ? 1 + n++ % 2 : n++ % 4], 11};
     req.set(http::field::host, "127.0.0.1");
     req.keep_alive(true);
     ++sent;
@@ -184,6 +193,45 @@ struct Rester : std::enable_shared_from_this<Rester> {
   }
 };
 
+/// A client that asks for `target` again as soon as each answer is in (keep-alive), until
+/// stopped: the heaviest polling one client can do over one connection.
+struct Hogger : std::enable_shared_from_this<Hogger> {
+  beast::tcp_stream stream;
+  beast::flat_buffer buffer;
+  http::request<http::empty_body> req{http::verb::get, "/api/state", 11};
+  http::response<http::string_body> res;
+  std::uint16_t port;
+  std::atomic<bool>* running;
+  std::uint64_t ok = 0, limited = 0, errors = 0, bytes = 0;
+  Hogger(net::io_context& ioc, std::uint16_t p, std::atomic<bool>* r)
+      : stream(ioc), port(p), running(r) {
+    req.set(http::field::host, "127.0.0.1");
+    req.keep_alive(true);
+  }
+  void start() {
+    stream.async_connect(local(port), [self = shared_from_this()](beast::error_code ec) {
+      if (ec) return void(++self->errors);
+      self->fire();
+    });
+  }
+  void fire() {
+    if (!running->load()) return;
+    stream.expires_after(std::chrono::seconds(5));
+    http::async_write(stream, req, [self = shared_from_this()](beast::error_code ec, std::size_t) {
+      if (ec) return void(++self->errors);
+      self->res = {};
+      self->res.body().reserve(1 << 19);
+      http::async_read(self->stream, self->buffer, self->res, [self](beast::error_code ec,
+                                                                     std::size_t) {
+        if (ec) return void(++self->errors);
+        (self->res.result_int() == 200 ? self->ok : self->limited)++;
+        self->bytes += self->res.body().size();
+        self->fire();
+      });
+    });
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -195,12 +243,19 @@ int main(int argc, char** argv) {
     else if (a == "--scene") scene = argv[i + 1];
     else return std::cerr << "unknown option " << a << "\n", 2;
   }
-  if (profile_name != "full" && profile_name != "ci") return std::cerr << "bad profile\n", 2;
-  const Profile p = profile_name == "full" ? kFull : kCi;
+  if (profile_name != "full" && profile_name != "ci" && profile_name != "hostile")
+    return std::cerr << "bad profile\n", 2;
+  const Profile p = profile_name == "full" ? kFull : profile_name == "ci" ? kCi : kHostile;
+  const bool hostile = p.squatters > 0;
+  if (hostile && scene == "seed") scene = "pile";
 
   // Its stderr stays on ours (warnings are worth seeing); stdout carries the URL line.
+  // hostile: the squatters fill every viewer slot the readers leave (then the late viewer
+  // finds none until they are dropped).
   ChildProcess child({server, "--port", "0", "--scene", scene, "--max-viewers",
-                      std::to_string(p.viewers + 10), "--render-ms", std::to_string(kRenderMs)},
+                      std::to_string(hostile ? p.viewers + 1 + p.squatters : p.viewers + 10),
+                      "--render-ms", std::to_string(kRenderMs), "--viewer-timeout-ms",
+                      std::to_string(hostile ? kViewerTimeoutMs : 15000)},
                      /*merge_stderr=*/false);
   const std::string url = child.line();
   if (url.find("http://") == std::string::npos) return std::cerr << "no server: " << url, 1;
@@ -227,6 +282,13 @@ int main(int argc, char** argv) {
   }
   // The stalled viewer: completes the upgrade, then never reads (tiny receive buffer).
   tcp::socket stalled = stalled_viewer(ioc, port);
+  std::vector<tcp::socket> squatters;
+  for (int i = 0; i < p.squatters; ++i) squatters.push_back(stalled_viewer(ioc, port));
+  std::atomic<bool> hogging{false};
+  std::vector<std::shared_ptr<Hogger>> hoggers;
+  for (int i = 0; i < p.hoggers; ++i)
+    hoggers.push_back(std::make_shared<Hogger>(ioc, port, &hogging));
+  std::shared_ptr<Viewer> late_viewer;  // hostile: joins 8 s into the loaded window.
 
   const auto t_start = Clock::now() + std::chrono::seconds(2);  // warm-up: connects settle
   const auto t_end = t_start + std::chrono::duration_cast<Clock::duration>(
@@ -239,6 +301,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < conns; ++i) {
     resters.push_back(std::make_shared<Rester>(
         ioc, port, std::chrono::microseconds(1000000LL * conns / p.rps), t_end));
+    resters.back()->cheap_only = hostile;
   }
   std::thread io([&] {
     auto guard = net::make_work_guard(ioc);
@@ -252,25 +315,50 @@ int main(int argc, char** argv) {
   m0 = http_get(port, "/metrics").body;
   const std::uint64_t dropped0 = static_cast<std::uint64_t>(metric(m0, "tumble_frames_dropped_total"));
   counting = true;
+  hogging = true;
   net::post(ioc, [&] {
     for (auto& r : resters) r->start();
+    for (auto& h : hoggers) h->start();
   });
-  double rtf_min = 1e9, rtf_sum = 0, rss_max = rss_start;
-  int samples = 0;
+  double rtf_min = 1e9, rtf_sum = 0, rss_max = rss_start, health_max_ms = 0;
+  int samples = 0, second = 0, viewers_at_1s = 0, squatters_gone_at = 0;
   for (auto t = t_start + std::chrono::seconds(1); t <= t_end; t += std::chrono::seconds(1)) {
     std::this_thread::sleep_until(t);
-    const nlohmann::json s = http_get(port, "/api/state").json();
-    if (!s.is_object()) {
+    ++second;
+    if (hostile && second % 5 == 0) {  // The squatters' one byte every 5 s.
+      net::post(ioc, [&] {
+        beast::error_code ec;
+        for (auto& q : squatters) q.write_some(net::buffer("\x82", 1), ec);
+      });
+    }
+    if (hostile && second == 8) {
+      late_viewer = std::make_shared<Viewer>(ioc, port, &counting);
+      net::post(ioc, [v = late_viewer] { v->start(); });
+    }
+    const auto h0 = Clock::now();
+    const unsigned health = http_get(port, "/api/health").status;
+    const double health_ms = std::chrono::duration<double, std::milli>(Clock::now() - h0).count();
+    health_max_ms = std::max(health_max_ms, health == 200 ? health_ms : 1e9);
+    // The real-time factor from /metrics (the same snapshot as /api/state's): a cheap read,
+    // outside the read budget that the hostile profile's hoggers spend for this address.
+    const HttpReply mr = http_get(port, "/metrics");
+    if (mr.status != 200) {
       rtf_min = 0;
       continue;
     }
-    const double rtf = s["real_time_factor"].get<double>();
+    if (hostile) {  // Viewer slots held: readers + stalled + squatters until they are dropped.
+      const int held = static_cast<int>(metric(mr.body, "tumble_viewers"));
+      if (second == 1) viewers_at_1s = held;
+      if (!squatters_gone_at && held <= p.viewers + (late_viewer ? 1 : 0)) squatters_gone_at = second;
+    }
+    const double rtf = metric(mr.body, "tumble_real_time_factor");
     rtf_min = std::min(rtf_min, rtf);
     rtf_sum += rtf;
     ++samples;
     rss_max = std::max(rss_max, rss_mb(child.pid()));
   }
   counting = false;
+  hogging = false;
   m1 = http_get(port, "/metrics").body;
   const double step_under = mean_step(m0, m1);
   const double rss_end = rss_mb(child.pid());
@@ -279,6 +367,9 @@ int main(int argc, char** argv) {
     for (auto& v : viewers) v->close();
     beast::error_code ec;
     stalled.close(ec);
+    for (auto& q : squatters) q.close(ec);
+    for (auto& h : hoggers) h->stream.socket().close(ec);
+    if (late_viewer) late_viewer->close();
     for (auto& r : resters) {
       r->timer.cancel();
       r->stream.socket().close(ec);
@@ -309,6 +400,18 @@ int main(int argc, char** argv) {
     late += r->late;
   }
   const double rest_share = static_cast<double>(ok) / std::max<double>(1, sent + late);
+  std::uint64_t hog_ok = 0, hog_limited = 0, hog_errors = 0, hog_bytes = 0;
+  for (auto& h : hoggers) {
+    hog_ok += h->ok;
+    hog_limited += h->limited;
+    hog_errors += h->errors;
+    hog_bytes += h->bytes;
+  }
+  const bool late_admitted = late_viewer && late_viewer->connected && !late_viewer->failed;
+  const double late_share =
+      late_admitted && late_viewer->received
+          ? late_viewer->received / static_cast<double>(late_viewer->last - late_viewer->first + 1)
+          : 0.0;
   const std::uint64_t dropped =
       static_cast<std::uint64_t>(metric(m1, "tumble_frames_dropped_total")) - dropped0;
   const int exit_code = child.stop();
@@ -356,11 +459,37 @@ int main(int argc, char** argv) {
        f(p.max_step_ratio, 1), step_ratio <= p.max_step_ratio},
       {"server exit code after SIGTERM", std::to_string(exit_code), "0", exit_code == 0},
   };
+  std::vector<Row> hostile_rows;
+  if (hostile) {
+    hostile_rows = {
+        {"health, slowest of 1 s samples, ms", f(health_max_ms, 1), "<= 50", health_max_ms <= 50},
+        {"expensive GETs (4 hoggers): 200 / 429 / errors",
+         std::to_string(hog_ok) + " / " + std::to_string(hog_limited) + " / " +
+             std::to_string(hog_errors),
+         "-", true},
+        {"expensive GETs: 200 answers/s, MB/s",
+         f(hog_ok / p.seconds, 1) + ", " + f(hog_bytes / p.seconds / 1e6, 1), "-", true},
+        {"viewer slots held 1 s in (readers + stalled + squatters)",
+         std::to_string(viewers_at_1s) + "/" + std::to_string(p.viewers + 1 + p.squatters), "-",
+         true},
+        {"stalled and squatters all dropped by", squatters_gone_at
+             ? std::to_string(squatters_gone_at + 2) + " s after joining" : "never",
+         "<= 1.5 x timeout + 1", squatters_gone_at && squatters_gone_at + 2 <= 7},
+        {"late viewer (8 s in) admitted", late_admitted ? "yes" : "no", "yes", late_admitted},
+        {"late viewer, share of frames", f(late_share), ">= " + f(p.min_frame_share, 2),
+         late_share >= p.min_frame_share},
+    };
+  }
   bool all = true;
   std::cout << "server_load profile " << profile_name << ": " << p.viewers << " viewers + 1 stalled, "
-            << p.rps << " REST/s, " << p.seconds << " s, scene " << scene << "\n\n"
-            << "| measure | value | criterion | |\n|---|---|---|---|\n";
-  for (const Row& r : rows) {
+            << p.rps << " REST/s, " << p.seconds << " s, scene " << scene;
+  if (hostile)
+    std::cout << ", " << p.squatters << " squatters, " << p.hoggers
+              << " clients looping GET /api/state, --viewer-timeout-ms " << kViewerTimeoutMs;
+  std::cout << "\n\n| measure | value | criterion | |\n|---|---|---|---|\n";
+  std::vector<Row> all_rows = rows;
+  all_rows.insert(all_rows.end(), hostile_rows.begin(), hostile_rows.end());
+  for (const Row& r : all_rows) {
     std::cout << "| " << r.what << " | " << r.value << " | " << r.limit << " | "
               << (r.pass ? "ok" : "FAIL") << " |\n";
     all = all && r.pass;

@@ -31,6 +31,30 @@ TEST(Options, Defaults) {
   EXPECT_EQ(p.options->max_viewers, 64);
   EXPECT_EQ(p.options->token, "");
   EXPECT_EQ(p.options->web_root, default_web_root());
+  EXPECT_FALSE(p.options->token_reads);
+  EXPECT_EQ(p.options->max_connections, 512);
+  EXPECT_EQ(p.options->step_budget_ms, 5000);
+  EXPECT_EQ(p.options->viewer_timeout_ms, 15000);
+  EXPECT_EQ(p.options->read_budget, 20000);
+}
+
+TEST(Options, HardeningLimits) {
+  const ParsedOptions p =
+      parse({"--token", "t", "--token-reads", "--max-connections", "100", "--step-budget-ms",
+             "250", "--viewer-timeout-ms", "2000", "--read-budget", "0"});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_TRUE(p.options->token_reads);
+  EXPECT_EQ(p.options->max_connections, 100);
+  EXPECT_EQ(p.options->step_budget_ms, 250);
+  EXPECT_EQ(p.options->viewer_timeout_ms, 2000);
+  EXPECT_EQ(p.options->read_budget, 0);
+  for (std::vector<const char*> bad :
+       {std::vector<const char*>{"--token-reads"}, {"--max-connections", "0"},
+        {"--step-budget-ms", "5"}, {"--viewer-timeout-ms", "10"}, {"--read-budget", "-1"}}) {
+    const ParsedOptions r = parse(bad);
+    EXPECT_FALSE(r.options) << bad[0];
+    EXPECT_EQ(r.exit_code, 2) << bad[0];
+  }
 }
 
 TEST(Options, CommandLine) {

@@ -28,6 +28,8 @@ class ServerTest : public ::testing::Test {
   virtual void configure(ServerOptions&) {}
   /// The scene the server starts with.
   virtual Scene initial_scene() { return load_scene("seed"); }
+  /// Called after the server is built and before it starts (e.g. to set test seams).
+  virtual void before_start(Server&) {}
 
   void SetUp() override {
     namespace fs = std::filesystem;
@@ -41,6 +43,9 @@ class ServerTest : public ::testing::Test {
     write_file(dir_ / "web" / "style.css", "body{}");
     write_file(dir_ / "web" / "data.json", "{}");
     write_file(dir_ / "secret.txt", "TOP-SECRET");
+    fs::create_directories(dir_ / "web" / "node_modules" / "pkg");
+    write_file(dir_ / "web" / "node_modules" / "pkg" / "index.js", "export const npm = 1;");
+    write_file(dir_ / "web" / ".env", "TOKEN=dotfile");
     fs::create_symlink(dir_ / "secret.txt", dir_ / "web" / "leak.txt");
     fs::create_symlink(dir_ / "web" / "style.css", dir_ / "web" / "alias.css");
     fs::create_directory_symlink(dir_, dir_ / "web" / "up");
@@ -52,6 +57,7 @@ class ServerTest : public ::testing::Test {
     o.threads = 2;
     configure(o);
     server_ = std::make_unique<Server>(o, initial_scene());
+    before_start(*server_);
     server_->start();
     port_ = server_->port();
   }

@@ -80,10 +80,16 @@ export class StreamConnection {
   }
 }
 
-/** The WebSocket URL of the page's server (same host, /ws beside the page). */
+/**
+ * The WebSocket URL of the page's server (same host, /ws beside the page). A `?token=` of the
+ * page goes along as `access_token` (a browser's WebSocket cannot send an Authorization
+ * header; the server wants it under --token-reads).
+ */
 export function streamUrl() {
   const url = new URL('ws', window.location.href);
   url.protocol = url.protocol === 'https:' ? 'wss:' : 'ws:';
+  const token = new URLSearchParams(window.location.search).get('token');
+  if (token) url.searchParams.set('access_token', token);
   return url.href;
 }
 
