@@ -220,7 +220,16 @@ CommandResult SimLoop::run_command(CommandKind& kind) {
 
 CommandResult SimLoop::reset(ResetCommand& c) {
   Scene scene = c.scene ? std::move(*c.scene) : world_->scene();
-  auto world = std::make_unique<World>(std::move(scene));  // May throw InvalidInput: no change.
+  std::unique_ptr<World> world;
+  try {
+    world = std::make_unique<World>(std::move(scene));
+  } catch (const InvalidInput& e) {
+    // The engine names the field first ("bodies: more than 65024 pairs …"): no change here.
+    const std::string what = e.what();
+    const std::size_t colon = what.find(": ");
+    return command_error(400, what,
+                         colon == std::string::npos ? "scene" : "scene." + what.substr(0, colon));
+  }
   world_ = std::move(world);
   new_scene_info();
   anchor(Clock::now());

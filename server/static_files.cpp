@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <optional>
 #include <string>
@@ -61,17 +62,30 @@ StaticLookup resolve_static(const std::filesystem::path& root, std::string_view 
   if (path.back() == '/') path += "index.html";
 
   // Every segment must be a plain name: no "..", ".", or empty segments ("//").
+  // The viewer's runtime modules (its import map: three, lil-gui, uplot) are served from
+  // /node_modules/; the rest of web/node_modules (build and test tooling, playwright-core
+  // among it: 38 MB) never is, nor are dotfiles (.git, .env …).
+  constexpr std::array<std::string_view, 3> kServedModules{"three", "lil-gui", "uplot"};
   fs::path relative;
   std::size_t start = 1;
-  while (start <= path.size()) {
+  bool in_node_modules = false;
+  for (int index = 0; start <= path.size(); ++index) {
     const std::size_t end = std::min(path.find('/', start), path.size());
     const std::string_view segment(path.data() + start, end - start);
-    // Dotfiles (.git, .env …) and the viewer's build-time npm modules are never content.
-    if (segment.empty() || segment.front() == '.' || segment == "node_modules")
-      return {403, {}};
+    if (segment.empty() || segment.front() == '.') return {403, {}};
+    if (segment == "node_modules") {
+      if (index != 0) return {403, {}};
+      in_node_modules = true;
+    } else if (in_node_modules) {
+      if (std::find(kServedModules.begin(), kServedModules.end(), segment) ==
+          kServedModules.end())
+        return {403, {}};
+      in_node_modules = false;
+    }
     relative /= fs::path(std::string(segment));
     start = end + 1;
   }
+  if (in_node_modules) return {403, {}};
 
   std::error_code ec;
   const fs::path resolved = fs::canonical(root / relative, ec);  // Follows symlinks.

@@ -65,6 +65,34 @@ void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& 
   }
 }
 
+/// Sorts pairs by (first, second) in O(n + pairs): a counting sort on the first body, then
+/// an insertion sort of each body's few partners. std::sort was 64 % of the broad phase of
+/// `pile`, which rebuilds its pairs nearly every step while boxes fall.
+void sort_pairs(std::vector<BodyPair>& pairs, std::size_t n, SweepScratch& scratch) {
+  std::vector<std::uint32_t>& start = scratch.bucket;
+  start.assign(n + 1, 0);
+  for (const BodyPair& p : pairs) ++start[p.first + 1];
+  for (std::size_t i = 1; i <= n; ++i) start[i] += start[i - 1];
+  scratch.sorted.resize(pairs.size());
+  for (const BodyPair& p : pairs) scratch.sorted[start[p.first]++] = p;
+  // start[i] is now the end of body i's bucket.
+  std::size_t begin = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t end = start[i];
+    for (std::size_t a = begin + 1; a < end; ++a) {
+      const BodyPair key = scratch.sorted[a];
+      std::size_t b = a;
+      while (b > begin && key.second < scratch.sorted[b - 1].second) {
+        scratch.sorted[b] = scratch.sorted[b - 1];
+        --b;
+      }
+      scratch.sorted[b] = key;
+    }
+    begin = end;
+  }
+  pairs.swap(scratch.sorted);
+}
+
 }  // namespace
 
 // Sweep and prune (Baraff 1992, "Dynamic simulation of non-penetrating rigid bodies", §7.4;
@@ -145,7 +173,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
       complete = false;
     }
   }
-  std::sort(pairs.begin(), pairs.end());
+  sort_pairs(pairs, n, scratch);
   return complete;
 }
 

@@ -34,6 +34,8 @@ struct SweepScratch {
   std::vector<double> start;              ///< Interval start of each body along the sweep.
   std::uint64_t sleeping_signature = ~0ull;  ///< Which sleeping set `sleeping` was sorted for.
   std::vector<std::uint8_t> listed;       ///< Scratch: body already in `awake`.
+  std::vector<std::uint32_t> bucket;      ///< Scratch of the pair sort: bucket ends.
+  std::vector<BodyPair> sorted;           ///< Scratch of the pair sort: the sorted pairs.
   double sleeping_width = 0.0;            ///< Widest sleeping interval, m.
 };
 

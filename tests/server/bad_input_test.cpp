@@ -178,6 +178,14 @@ const std::vector<Case>& cases() {
       {"ImpulsePastSpinLimit",
        POST("/api/impulse", R"({"body": 0, "impulse": [0, 0, 100], "point": [0, 1e3, 0]})"), 400,
        "impulse"},
+      {"ScenePackedAtOnePoint",  // 2,000 boxes at one point: two million pairs (issue 12, item 2)
+       RESET([](json& s) {
+         json bodies = json::array();
+         for (int i = 0; i < 2000; ++i)
+           bodies.push_back({{"name", "b" + std::to_string(i)}, {"position", {0, 5, 0}}});
+         s["bodies"] = bodies;
+       }),
+       400, "scene.bodies"},
       {"SceneDtTiny",
        RESET([](json& s) {
          s["dt"] = 1e-9;  // Valid for the engine (its TOI tolerance below it), but a busy loop.
@@ -346,6 +354,8 @@ const std::vector<Case>& cases() {
       {"BadPercentEscape", GET("/%zz"), 400, ""},
       {"NoDirectoryListing", GET("/empty/"), 404, ""},
       {"NodeModulesNotServed", GET("/node_modules/pkg/index.js"), 403, ""},
+      {"NodeModulesToolingNotServed", GET("/node_modules/playwright-core/package.json"), 403, ""},
+      {"NodeModulesListingNotServed", GET("/node_modules/"), 403, ""},
       {"DotfileNotServed", GET("/.env"), 403, ""},
       // ---- WebSocket ---------------------------------------------------------------------
       {"WsWrongOrigin",
