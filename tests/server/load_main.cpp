@@ -1,11 +1,13 @@
 /// server_load: a bounded load test of a tumble-server child process on 127.0.0.1.
-///   server_load [--profile full|ci|hostile] [--server PATH] [--scene NAME]
+///   server_load [--profile full|ci|hostile|full-hostile] [--server PATH] [--scene NAME]
 /// full: 200 WebSocket viewers that keep up, 1 that never reads, 1000 REST requests/s for
 ///       20 s. ci: 20 viewers, 1 stalled, 200 requests/s for 5 s.
 /// hostile (issue 12): scene pile (1,000 bodies, 364 KB states), 20 viewers and 200 cheap
 ///       requests/s as in ci, plus 4 clients looping GET /api/state back to back and 64
 ///       squatting sockets (upgrade, one byte every 5 s, never read) that fill every free
 ///       viewer slot; --viewer-timeout-ms 4000; a late viewer joins 8 s in and must be fed.
+/// full-hostile (issue 12): the full profile (scene seed) with hostile's 4 looping clients and
+///       64 squatters added.
 /// Measures (over the loaded window, after a 2 s warm-up): the real-time factor (min of 1 s
 /// samples of /api/state), the fraction of broadcast frames each reader got (from the frame
 /// numbers), the server's resident memory growth, the mean step time before and under load,
@@ -61,6 +63,10 @@ struct Profile {
 constexpr Profile kFull{200, 1000, 20.0, 0.99, 0.95, 10.0, 3.0, 0.99};
 constexpr Profile kCi{20, 200, 5.0, 0.90, 0.80, 20.0, 5.0, 0.95};
 constexpr Profile kHostile{20, 200, 20.0, 0.98, 0.95, 20.0, 5.0, 0.99, 64, 4};
+// The full profile with the hostile clients added (issue 12's "full load profile re-run with
+// 4 clients looping the most expensive GET and 64 squatting sockets"), on the full profile's
+// scene: 200 pile viewers would need ~1 GB/s of frames, beyond this 2-core machine.
+constexpr Profile kFullHostile{200, 1000, 20.0, 0.98, 0.95, 20.0, 5.0, 0.99, 64, 4};
 constexpr int kViewerTimeoutMs = 4000;  // hostile: squatters are dropped within 1.5 × this.
 constexpr int kRenderMs = 20;
 
@@ -243,11 +249,15 @@ int main(int argc, char** argv) {
     else if (a == "--scene") scene = argv[i + 1];
     else return std::cerr << "unknown option " << a << "\n", 2;
   }
-  if (profile_name != "full" && profile_name != "ci" && profile_name != "hostile")
+  if (profile_name != "full" && profile_name != "ci" && profile_name != "hostile" &&
+      profile_name != "full-hostile")
     return std::cerr << "bad profile\n", 2;
-  const Profile p = profile_name == "full" ? kFull : profile_name == "ci" ? kCi : kHostile;
+  const Profile p = profile_name == "full"           ? kFull
+                    : profile_name == "ci"           ? kCi
+                    : profile_name == "full-hostile" ? kFullHostile
+                                                     : kHostile;
   const bool hostile = p.squatters > 0;
-  if (hostile && scene == "seed") scene = "pile";
+  if (profile_name == "hostile" && scene == "seed") scene = "pile";
 
   // Its stderr stays on ours (warnings are worth seeing); stdout carries the URL line.
   // hostile: the squatters fill every viewer slot the readers leave (then the late viewer
