@@ -134,6 +134,41 @@ bool stick_on_one_vertex(const BodyState& s0, const Kinematics& k0, const Vec3& 
   return true;
 }
 
+/// The last rounds' friction and twist impulses, for extrapolation.
+struct RoundHistory {
+  int count = 0;
+  std::array<Eigen::Vector2d, 2> friction;
+  std::array<double, 2> twist{};
+};
+
+// The rounds below converge linearly: for a box sticking on an edge each round removes about
+// 60 % of the error, so 16 rounds ended near 1e-7 relative, never at 1e-13. Aitken's Δ²
+// process (Aitken 1926) turns three iterates x₀, x₁, x₂ of such a sequence into its limit
+// x₂ + ρ/(1 − ρ) (x₂ − x₁), ρ the ratio of successive changes: the friction impulse and the
+// twist each get it once they have three iterates whose change shrinks steadily (0 < ρ < 0.9),
+// then start afresh; the result is put back inside the friction cone, and the rounds go on
+// from there, so the answer is still the rounds' own fixed point.
+void extrapolate(RoundHistory& h, Eigen::Vector2d& friction, double& twist, double limit,
+                 double twist_limit) {
+  if (h.count < 2) {
+    h.friction[h.count] = friction;
+    h.twist[h.count] = twist;
+    ++h.count;
+    return;
+  }
+  const Eigen::Vector2d d1 = h.friction[1] - h.friction[0], d2 = friction - h.friction[1];
+  const double rho = d1.squaredNorm() > 0.0 ? d2.dot(d1) / d1.squaredNorm() : 0.0;
+  if (rho > 0.0 && rho < 0.9) {
+    friction += rho / (1.0 - rho) * d2;
+    if (friction.norm() > limit) friction *= limit / friction.norm();
+  }
+  const double t1 = h.twist[1] - h.twist[0], t2 = twist - h.twist[1];
+  const double tau = t1 != 0.0 ? t2 / t1 : 0.0;
+  if (tau > 0.0 && tau < 0.9)
+    twist = std::clamp(twist + tau / (1.0 - tau) * t2, -twist_limit, twist_limit);
+  h.count = 0;
+}
+
 // Coulomb friction on the contact patch as a whole, alternated with the exact normal solve
 // to a fixed point: the tangential impulse F acts at the normal-impulse-weighted centroid of
 // the contacts, cancels the sliding velocity there through its 2×2 tangential mass, and is
@@ -156,6 +191,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
   double twist = 0.0;  // torsional impulse about the normal, N·m·s
   const Vec3 up = Vec3::UnitY();
+  RoundHistory history;
   for (int round = 0; round < 16; ++round) {
     double total = 0.0;
     Vec3 centroid = Vec3::Zero();
@@ -183,6 +219,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
                          std::abs(next_twist - twist) <= 1e-13 * (1.0 + std::abs(next_twist));
     friction = next;
     twist = next_twist;
+    if (!settled) extrapolate(history, friction, twist, mu * total, mu * total * radius);
     s = s0;
     k = k0;
     k.apply(s, centroid, Vec3(friction.x(), 0.0, friction.y()));
