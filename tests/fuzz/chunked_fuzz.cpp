@@ -29,6 +29,7 @@
 #include "request_limits.hpp"
 #include "rest_api.hpp"
 #include "server.hpp"
+#include "server_fixture.hpp"
 #include "tumble/scene_io.hpp"
 
 namespace boost {
@@ -55,25 +56,12 @@ namespace {
 using namespace tumble::server;
 namespace http = boost::beast::http;
 
-struct Fixture {
-  ServerOptions options;
-  Metrics metrics;
-  SimLoop sim{tumble::load_scene("seed"), metrics};
-  boost::asio::io_context ioc;
-  Broadcaster broadcaster{ioc, sim, std::chrono::milliseconds(20), 4};
-  ConnectionCount connections{4};
-  ReadBudget read_budget{0, 0};
-  ServerContext ctx{options, std::filesystem::temp_directory_path(), sim, broadcaster, metrics,
-                    connections, read_budget};
-  Fixture() { sim.stop(); }  // Never started: commands complete at once with 503.
-};
-
 constexpr const char* kTargets[] = {"/api/step", "/api/reset", "/api/impulse", "/api/pause"};
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static Fixture f;
+  static fuzz::ServerFixture f;
   if (size < 2) return 0;
   const std::size_t piece = 1 + data[0] % 97;
   const std::string head = std::string("POST ") + kTargets[data[1] % 4] +

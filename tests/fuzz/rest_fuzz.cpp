@@ -16,6 +16,7 @@
 #include "request_limits.hpp"
 #include "rest_api.hpp"
 #include "server.hpp"
+#include "server_fixture.hpp"
 #include "static_files.hpp"
 #include "tumble/scene_io.hpp"
 
@@ -24,27 +25,10 @@ namespace {
 using namespace tumble::server;
 namespace http = boost::beast::http;
 
-struct Fixture {
-  ServerOptions options;
-  Metrics metrics;
-  SimLoop sim{tumble::load_scene("seed"), metrics};
-  boost::asio::io_context ioc;
-  Broadcaster broadcaster{ioc, sim, std::chrono::milliseconds(20), 4};
-  ConnectionCount connections{64};
-  ReadBudget read_budget{0, 0};
-  ServerContext ctx{options, std::filesystem::temp_directory_path(), sim, broadcaster, metrics,
-                    connections, read_budget};
-  Fixture() {
-    options.token = "fuzz-token";
-    options.allowed_origin = "http://viewer.example";
-    sim.stop();  // never started: commands complete at once with 503
-  }
-};
-
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static Fixture f;
+  static fuzz::ServerFixture f("fuzz-token", "http://viewer.example");
   RequestParser parser;
   limit_parser(parser);
   parser.eager(true);
