@@ -1,5 +1,6 @@
 #include "broad_phase.hpp"
 
+#include <atomic>
 #include <cmath>
 
 #include "pipeline.hpp"
@@ -93,6 +94,31 @@ void sort_pairs(std::vector<BodyPair>& pairs, std::size_t n, SweepScratch& scrat
   pairs.swap(scratch.sorted);
 }
 
+/// The sweep for awake[first, last): pairs with the awake bodies after each one and with the
+/// sleeping ones, appended to `out`; stops once `out` holds more than max_pairs.
+void sweep_range(const SweepScratch& scratch, std::span<const Aabb> boxes, std::size_t first,
+                 std::size_t last, std::vector<BodyPair>& out, std::size_t max_pairs) {
+  const std::vector<std::uint32_t>& awake = scratch.awake;
+  const std::vector<std::uint32_t>& sleeping = scratch.sleeping;
+  for (std::size_t i = first; i < last && out.size() <= max_pairs; ++i) {
+    const std::uint32_t a = awake[i];
+    const Aabb& ba = boxes[a];
+    const double end = interval_end(ba);
+    for (std::size_t j = i + 1; j < awake.size(); ++j) {
+      const std::uint32_t b = awake[j];
+      if (scratch.start[b] > end) break;
+      if (overlap(ba, boxes[b])) add_pair(out, a, b);
+    }
+    // Sleeping boxes whose interval can overlap [start, end]: they start after
+    // start − widest and before end.
+    auto from = std::lower_bound(sleeping.begin(), sleeping.end(),
+                                 scratch.start[a] - scratch.sleeping_width,
+                                 [&](std::uint32_t s, double v) { return scratch.start[s] < v; });
+    for (auto it = from; it != sleeping.end() && scratch.start[*it] <= end; ++it)
+      if (overlap(ba, boxes[*it])) add_pair(out, a, *it);
+  }
+}
+
 }  // namespace
 
 // Sweep and prune (Baraff 1992, "Dynamic simulation of non-penetrating rigid bodies", §7.4;
@@ -105,7 +131,8 @@ void sort_pairs(std::vector<BodyPair>& pairs, std::size_t n, SweepScratch& scrat
 bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
                 std::span<const std::uint8_t> candidate,
                 std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
-                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs) {
+                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs,
+                WorkerPool& pool) {
   pairs.clear();
   const std::size_t n = boxes.size();
   scratch.start.resize(n);
@@ -150,29 +177,23 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
               });
     scratch.sleeping_signature = sleeping_key;
   }
-  const std::vector<std::uint32_t>& sleeping = scratch.sleeping;
-  bool complete = true;
-  for (std::size_t i = 0; i < awake.size() && complete; ++i) {
-    const std::uint32_t a = awake[i];
-    const Aabb& ba = boxes[a];
-    const double end = interval_end(ba);
-    for (std::size_t j = i + 1; j < awake.size(); ++j) {
-      const std::uint32_t b = awake[j];
-      if (scratch.start[b] > end) break;
-      if (overlap(ba, boxes[b])) add_pair(pairs, a, b);
+  // The sweep's outer loop is shared among the pool's threads in fixed ranges, each with its
+  // own list; joined in range order they are the pairs of the loop in order.
+  const std::size_t ranges = std::min<std::size_t>(4 * pool.size(), awake.size() / 64 + 1);
+  scratch.range_pairs.resize(ranges);
+  pool.for_each(ranges, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t r = begin; r < end; ++r) {
+      std::vector<BodyPair>& out = ranges == 1 ? pairs : scratch.range_pairs[r];
+      if (ranges > 1) out.clear();
+      sweep_range(scratch, boxes, awake.size() * r / ranges, awake.size() * (r + 1) / ranges,
+                  out, max_pairs);
     }
-    // Sleeping boxes whose interval can overlap [start, end]: they start after
-    // start − widest and before end.
-    auto first = std::lower_bound(sleeping.begin(), sleeping.end(),
-                                  scratch.start[a] - scratch.sleeping_width,
-                                  [&](std::uint32_t s, double v) { return scratch.start[s] < v; });
-    for (auto it = first; it != sleeping.end() && scratch.start[*it] <= end; ++it)
-      if (overlap(ba, boxes[*it])) add_pair(pairs, a, *it);
-    if (pairs.size() > max_pairs) {
-      pairs.resize(max_pairs);
-      complete = false;
-    }
-  }
+  });
+  if (ranges > 1)
+    for (const std::vector<BodyPair>& part : scratch.range_pairs)
+      pairs.insert(pairs.end(), part.begin(), part.end());
+  const bool complete = pairs.size() <= max_pairs;  // a range stops only past max_pairs
+  if (pairs.size() > max_pairs) pairs.resize(max_pairs);
   sort_pairs(pairs, n, scratch);
   return complete;
 }
@@ -242,24 +263,34 @@ void rescan(StepContext& ctx) {
 // Between changes of activity (counted by ContactCache::activity_epoch) a step touches only
 // the awake bodies: 10,000 sleeping boxes cost nothing.
 void broad_phase(StepContext& ctx) {
+  constexpr std::size_t kGrain = 256;  // bodies per chunk: ~30 ns each
   StepScratch& s = ctx.scratch;
   BroadPhaseCache& k = ctx.broad;
   s.pairs.clear();
   const std::size_t n = ctx.bodies.size();
   const bool full = k.epoch != ctx.cache.activity_epoch || k.active.size() != n;
   if (full) rescan(ctx);
-  bool rebuild = full || !k.fat_valid;
-  for (std::uint32_t i : k.awake) rebuild = update_box(ctx, i) || rebuild;
-  if (n < 2 || k.awake.empty()) return;
-  for (std::size_t a = 0; a < k.awake.size() && !rebuild; ++a)
-    rebuild = !contains(k.fat[k.awake[a]], k.boxes[k.awake[a]]);
-  if (rebuild) {
-    for (std::uint32_t i : k.awake) {
-      const double margin = 0.5 * ctx.bodies[i].c.bounding_radius;
-      k.fat[i] = {k.boxes[i].lo.array() - margin, k.boxes[i].hi.array() + margin};
+  // Each awake body's box on its own, shared among the pool's threads; the flags are ORed.
+  std::atomic<bool> rebuild = full || !k.fat_valid;
+  ctx.pool.for_each(k.awake.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    bool changed = false;
+    for (std::size_t a = begin; a < end; ++a) {
+      const std::uint32_t i = k.awake[a];
+      changed = update_box(ctx, i) || changed || !contains(k.fat[i], k.boxes[i]);
     }
+    if (changed) rebuild.store(true, std::memory_order_relaxed);
+  });
+  if (n < 2 || k.awake.empty()) return;
+  if (rebuild.load()) {
+    ctx.pool.for_each(k.awake.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t a = begin; a < end; ++a) {
+        const std::uint32_t i = k.awake[a];
+        const double margin = 0.5 * ctx.bodies[i].c.bounding_radius;
+        k.fat[i] = {k.boxes[i].lo.array() - margin, k.boxes[i].hi.array() + margin};
+      }
+    });
     k.fat_complete = find_pairs(k.fat, k.active, k.candidate, k.awake, k.epoch, k.sweep,
-                                k.fat_pairs, pair_budget(n));
+                                k.fat_pairs, pair_budget(n), ctx.pool);
     k.fat_valid = true;
   }
   for (const BodyPair& p : k.fat_pairs)
@@ -282,7 +313,8 @@ std::size_t initial_pairs(std::span<const Body> bodies, const Vec3& gravity) {
   std::vector<BodyPair> pairs;
   std::vector<std::uint32_t> all(n);
   for (std::size_t i = 0; i < n; ++i) all[i] = static_cast<std::uint32_t>(i);
-  find_pairs(boxes, active, candidate, all, 0, sweep, pairs, pair_budget(n) + 1);
+  WorkerPool alone(1);
+  find_pairs(boxes, active, candidate, all, 0, sweep, pairs, pair_budget(n) + 1, alone);
   return pairs.size();
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tumble/body.hpp"
+#include "worker_pool.hpp"
 
 namespace tumble {
 
@@ -37,6 +38,7 @@ struct SweepScratch {
   std::vector<std::uint32_t> bucket;      ///< Scratch of the pair sort: bucket ends.
   std::vector<BodyPair> sorted;           ///< Scratch of the pair sort: the sorted pairs.
   double sleeping_width = 0.0;            ///< Widest sleeping interval, m.
+  std::vector<std::vector<BodyPair>> range_pairs;  ///< Scratch: pairs of each sweep range.
 };
 
 /// Every pair whose boxes overlap and of which at least one body is `active` (sleeping pairs
@@ -46,11 +48,13 @@ struct SweepScratch {
 /// sort on last step's order); the sleeping ones are sorted only when their set changes and
 /// are found by binary search, so 10,000 sleeping boxes cost nothing per step. Stops after
 /// `max_pairs` pairs (a bound on the memory and time one step can take when a scene packs
-/// bodies into one another) and returns false then; true when every pair was found.
+/// bodies into one another) and returns false then; true when every pair was found. The sweep
+/// is shared among the threads of `pool`; the pairs do not depend on their number.
 bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
                 std::span<const std::uint8_t> candidate,
                 std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
-                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs);
+                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs,
+                WorkerPool& pool);
 
 /// The pair budget of a world of `body_count` bodies: 32 per body plus 1,024. A resting pile
 /// has about 7 per body (`pile`: 6,852 pairs for 1,000 bodies at most).

@@ -42,7 +42,7 @@ void contact_solve(StepContext& ctx) {
     warm_start(ctx);
     ctx.stats.impacts += static_cast<std::uint32_t>(
         solve_contacts(ctx.bodies, s.solver_bodies, s.contacts, ctx.world.gravity, ctx.dt,
-                       SolverSettings{}, s.solver));
+                       SolverSettings{}, s.solver, ctx.pool));
   }
   keep_for_warm_start(ctx);
 }

@@ -1,12 +1,14 @@
 #include "contact_solver.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <Eigen/Eigenvalues>
 
 #include "active_set.hpp"
 #include "floor_contact.hpp"
+#include "worker_pool.hpp"
 
 namespace tumble {
 namespace {
@@ -23,21 +25,27 @@ void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
 
 class Solver {
  public:
-  Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch)
+  /// The solver bodies of `ids` with their velocities at the step start, gravity's
+  /// `gravity_dv` (m/s) added to v.
+  Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch,
+         WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
         rows_(scratch.rows), fixed_(scratch.fixed), order_(scratch.order) {
     index_.resize(bodies.size(), -1);
     fixed_ = SolverBody{};
     sb_.resize(ids.size());
-    for (std::size_t k = 0; k < ids.size(); ++k) {
-      const Body& b = bodies[ids[k]];
-      index_[ids[k]] = static_cast<std::int32_t>(k);
-      sb_[k] = SolverBody{};
-      sb_[k].inv_mass = b.c.inv_mass;
-      sb_[k].inv_inertia = inverse_inertia_world(b.s, b.c);
-      sb_[k].v = b.s.P * b.c.inv_mass;
-      sb_[k].w = sb_[k].inv_inertia * b.s.L;
-    }
+    pool.for_each(ids.size(), 128, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const Body& b = bodies[ids[k]];
+        index_[ids[k]] = static_cast<std::int32_t>(k);
+        sb_[k] = SolverBody{};
+        sb_[k].inv_mass = b.c.inv_mass;
+        sb_[k].inv_inertia = inverse_inertia_world(b.s, b.c);
+        sb_[k].v = b.s.P * b.c.inv_mass;
+        sb_[k].w = sb_[k].inv_inertia * b.s.L;
+        sb_[k].v += gravity_dv;
+      }
+    });
   }
 
   SolverBody* body(std::uint32_t id) { return id == kStaticBody ? nullptr : &sb_[index_[id]]; }
@@ -80,8 +88,7 @@ class Solver {
       for (int k = 0; k < 2; ++k) p.tangent_mass[k] = 1.0 / inverse_mass(a, b, p.ra, p.rb, t[k]);
       p.pseudo_impulse = 0.0;
     }
-    if (rows_.size() <= n) rows_.resize(n + 1);
-    ContactRows& block = rows_[n];
+    ContactRows& block = rows_[n];  // sized by the caller
     block.dir = {c.normal, t[0], t[1]};
     for (int i = 0; i < c.count; ++i) {
       const ContactPoint& p = c.points[i];
@@ -130,8 +137,9 @@ class Solver {
     b.v += (b.inv_mass * j) * d;
     b.w += j * r.inv_b[k];
   }
-  /// Writes the end-of-step momenta P = m v, L = I w (I at the step start).
-  void finish();
+  /// Writes the end-of-step momenta P = m v, L = I w (I at the step start) of solver bodies
+  /// [begin, end).
+  void finish(std::size_t begin, std::size_t end);
   /// Forgets the body index, so the next step starts from an index of −1 only.
   void release();
   /// Normal velocity a point must reach: a speculative point may close its gap within the
@@ -365,8 +373,8 @@ void Solver::solve_position(Contact& c, std::size_t index, const SolverSettings&
   }
 }
 
-void Solver::finish() {
-  for (std::size_t k = 0; k < ids_.size(); ++k) {
+void Solver::finish(std::size_t begin, std::size_t end) {
+  for (std::size_t k = begin; k < end; ++k) {
     Body& body = bodies_[ids_[k]];
     const SolverBody& s = sb_[k];
     body.s.P = body.c.mass * s.v;
@@ -435,31 +443,62 @@ void warm_start_from(Contact& contact, const Contact& previous) {
   }
 }
 
+namespace {
+
+/// Runs fn(contact, index) over the contacts colour by colour, each colour shared among the
+/// pool's threads (its contacts touch disjoint bodies); the overflow colour runs in order.
+template <typename Fn>
+void sweep(const ContactColours& colours, std::span<Contact> contacts, WorkerPool& pool,
+           Fn&& fn) {
+  constexpr std::size_t kGrain = 32;  // contacts per chunk: 0.1–0.5 µs each
+  for (std::size_t k = 0; k < colours.count(); ++k) {
+    const std::span<const std::uint32_t> colour = colours.of(k);
+    const std::size_t grain = k == kMaxColours ? colour.size() : kGrain;
+    pool.for_each(colour.size(), grain, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) fn(contacts[colour[i]], colour[i]);
+    });
+  }
+}
+
+}  // namespace
+
 // The velocities of the bodies in contact, in the order of Guendelman, Bridson & Fedkiw 2003:
 // gravity, the collision pass (impacts with restitution), the contact pass (sequential
 // impulses, e = 0); positions then follow in flight with the corrected velocities
 // (semi-implicit Euler), the split-impulse pseudo velocities added to the positions only.
+// Every pass but shock propagation (ordered by height) sweeps the contacts colour by colour.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
-                   const SolverSettings& settings, SolverScratch& scratch) {
-  Solver solver(bodies, solver_bodies, scratch);
-  for (std::uint32_t id : solver_bodies) {
-    SolverBody* s = solver.body(id);
-    s->v += dt * gravity;
+                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool) {
+  constexpr std::size_t kBodyGrain = 128;
+  Solver solver(bodies, solver_bodies, scratch, pool, dt * gravity);
+  scratch.colour_a.resize(contacts.size());
+  scratch.colour_b.resize(contacts.size());
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    scratch.colour_a[i] = contacts[i].a == kStaticBody ? -1 : scratch.index[contacts[i].a];
+    scratch.colour_b[i] = scratch.index[contacts[i].b];
   }
-  for (std::size_t i = 0; i < contacts.size(); ++i) solver.prepare(contacts[i], i);
-  int impacts = 0;
-  for (Contact& c : contacts) impacts += solver.impact(c, gravity, dt);
-  for (std::size_t i = 0; i < contacts.size(); ++i) solver.warm_start(contacts[i], i);
+  colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), scratch.colours);
+  if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
+  pool.for_each(contacts.size(), 32, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) solver.prepare(contacts[i], i);
+  });
+  const ContactColours& colours = scratch.colours;
+  std::atomic<int> impacts{0};
+  sweep(colours, contacts, pool, [&](Contact& c, std::size_t) {
+    if (solver.impact(c, gravity, dt)) impacts.fetch_add(1, std::memory_order_relaxed);
+  });
+  sweep(colours, contacts, pool, [&](Contact& c, std::size_t i) { solver.warm_start(c, i); });
   for (int it = 0; it < settings.velocity_iterations; ++it)
-    for (std::size_t i = 0; i < contacts.size(); ++i) solver.solve_velocity(contacts[i], i, dt);
+    sweep(colours, contacts, pool, [&](Contact& c, std::size_t i) { solver.solve_velocity(c, i, dt); });
   if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt);
   for (int it = 0; it < settings.position_iterations; ++it)
-    for (std::size_t i = 0; i < contacts.size(); ++i)
-      solver.solve_position(contacts[i], i, settings, dt);
-  solver.finish();
+    sweep(colours, contacts, pool,
+          [&](Contact& c, std::size_t i) { solver.solve_position(c, i, settings, dt); });
+  pool.for_each(solver_bodies.size(), kBodyGrain,
+                [&](std::size_t begin, std::size_t end) { solver.finish(begin, end); });
   solver.release();
-  return impacts;
+  return impacts.load();
 }
 
 }  // namespace tumble

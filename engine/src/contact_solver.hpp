@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "active_set.hpp"
+#include "contact_colours.hpp"
 #include "tumble/body.hpp"
 
 namespace tumble {
@@ -100,7 +101,11 @@ struct SolverScratch {
   std::vector<ContactRows> rows;      ///< Solver rows of each contact.
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
   std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
+  std::vector<std::int32_t> colour_a, colour_b;  ///< Solver index of each contact's bodies.
+  ContactColours colours;                        ///< The contacts grouped by colour.
 };
+
+class WorkerPool;
 
 /// Solves the velocities of `bodies[solver_bodies]` over dt under gravity with the contacts:
 /// impacts (relative normal speed above the restitution threshold) get an exact simultaneous
@@ -108,9 +113,10 @@ struct SolverScratch {
 /// friction keep resting contacts from approaching; a split-impulse pass finds the pseudo
 /// velocities that remove deep penetration. Writes the bodies' end-of-step momenta P, L (their
 /// positions are flight's job) and leaves v, w, vp, wp in scratch.bodies. Returns the number
-/// of impacts.
+/// of impacts. Contacts of one colour (contact_colours.hpp) are solved at the same time on the
+/// threads of `pool`; the result does not depend on their number.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
-                   const SolverSettings& settings, SolverScratch& scratch);
+                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool);
 
 }  // namespace tumble

@@ -1,9 +1,14 @@
+#include <atomic>
+
 #include "floor_contact.hpp"
 #include "integrators.hpp"
 #include "pipeline.hpp"
 
 namespace tumble {
 namespace {
+
+constexpr std::size_t kIslandGrain = 256;  // bodies per chunk: ~20 ns each
+constexpr std::size_t kLoneGrain = 64;     // bodies per chunk: 0.1–1 µs each
 
 // An island body's momenta already hold the step's gravity and contact impulses (the contact
 // solve is velocity-level, Box2D's order: integrate velocities, solve, integrate positions), so
@@ -22,19 +27,28 @@ void fly_in_island(Body& b, const SolverBody& solved, double dt) {
 
 }  // namespace
 
+// Every body moves on its own, so the bodies are shared out among the pool's threads; the
+// counters are integers, whose sum does not depend on the order of the chunks.
 void flight(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
-  for (std::size_t k = 0; k < s.solver_bodies.size(); ++k)
-    fly_in_island(ctx.bodies[s.solver_bodies[k]], s.solver.bodies[k], ctx.dt);
+  ctx.pool.for_each(s.solver_bodies.size(), kIslandGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k)
+      fly_in_island(ctx.bodies[s.solver_bodies[k]], s.solver.bodies[k], ctx.dt);
+  });
   // A lone body flies with the scene's integrator, its floor impacts found at their time of
   // impact and resting contact handled exactly (floor_contact.cpp).
-  for (std::uint32_t id : s.lone_bodies) {
-    Body& b = ctx.bodies[id];
-    const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt);
-    ctx.stats.impacts += static_cast<std::uint32_t>(r.impacts);
-    ctx.stats.toi_iterations += static_cast<std::uint32_t>(r.toi_iterations);
-    b.in_contact = r.touched;
-  }
+  ctx.pool.for_each(s.lone_bodies.size(), kLoneGrain, [&](std::size_t begin, std::size_t end) {
+    std::uint32_t impacts = 0, iterations = 0;
+    for (std::size_t k = begin; k < end; ++k) {
+      Body& b = ctx.bodies[s.lone_bodies[k]];
+      const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt);
+      impacts += static_cast<std::uint32_t>(r.impacts);
+      iterations += static_cast<std::uint32_t>(r.toi_iterations);
+      b.in_contact = r.touched;
+    }
+    std::atomic_ref(ctx.stats.impacts).fetch_add(impacts, std::memory_order_relaxed);
+    std::atomic_ref(ctx.stats.toi_iterations).fetch_add(iterations, std::memory_order_relaxed);
+  });
 }
 
 }  // namespace tumble

@@ -11,18 +11,22 @@
 ///   finalize      → finalize.cpp      finiteness (freeze) and re-orthonormalisation
 ///   update_sleep  → sleep.cpp         one rule: an island still for long enough sleeps
 ///
-/// Not thread-safe: the World's owner thread runs the stages.
+/// The World's owner thread runs the stages; a stage may share independent work (bodies,
+/// pairs, contacts of one colour) among the threads of ctx.pool, each index writing only its
+/// own outputs, so results are bit-identical for any number of threads.
 #include <cstdint>
 #include <span>
 #include <utility>
 #include <vector>
 
+#include "box_box.hpp"
 #include "broad_phase.hpp"
 #include "contact_solver.hpp"
 #include "islands.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
 #include "tumble/step_stats.hpp"
+#include "worker_pool.hpp"
 
 namespace tumble {
 
@@ -61,6 +65,7 @@ struct StepScratch {
   std::vector<BodyPair> pairs;          ///< Broad-phase pairs (sorted).
   std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
   std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.
+  std::vector<BoxManifold> manifolds;   ///< Manifold of each pair (count 0: no contact).
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
   std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
@@ -83,6 +88,7 @@ struct StepContext {
   BroadPhaseCache& broad;    ///< Broad-phase acceleration.
   StepScratch& scratch;      ///< This step's buffers.
   StepStats& stats;          ///< This step's counters.
+  WorkerPool& pool;          ///< Threads for the stages' independent work (1: inline).
 };
 
 /// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island).

@@ -53,6 +53,7 @@ World::World(Scene scene) : scene_(std::move(scene)) {
   cache_ = std::make_unique<ContactCache>();
   broad_ = std::make_unique<BroadPhaseCache>();
   scratch_ = std::make_unique<StepScratch>();
+  pool_ = std::make_unique<WorkerPool>(1);
   init_caches(*cache_, bodies_.size());
 }
 
@@ -66,7 +67,8 @@ World::World(const World& other)
       time_stages_(other.time_stages_),
       cache_(std::make_unique<ContactCache>(*other.cache_)),
       broad_(std::make_unique<BroadPhaseCache>()),
-      scratch_(std::make_unique<StepScratch>()) {}
+      scratch_(std::make_unique<StepScratch>()),
+      pool_(std::make_unique<WorkerPool>(other.threads())) {}
 
 World& World::operator=(const World& other) {
   if (this != &other) *this = World(other);
@@ -83,7 +85,8 @@ void World::step() { step(scene_.world.dt); }
 void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0)) throw InvalidInput("dt must be finite and > 0");
   last_ = {};
-  StepContext ctx{scene_.world, dt, steps_, bodies_, *cache_, *broad_, *scratch_, last_};
+  StepContext ctx{scene_.world, dt,       steps_, bodies_, *cache_,
+                  *broad_,       *scratch_, last_,  *pool_};
   for (int round = 0; round < kMaxWakeRounds; ++round) {
     run_stage(Stage::broad_phase, broad_phase, ctx, time_stages_);
     run_stage(Stage::narrow_phase, narrow_phase, ctx, time_stages_);
@@ -116,6 +119,15 @@ void World::apply_impulse(BodyId id, const Vec3& impulse) {
 }
 
 void World::set_stage_timing(bool on) { time_stages_ = on; }
+
+void World::set_threads(unsigned threads) {
+  if (threads == 0) threads = hardware_threads();
+  if (threads != pool_->size()) pool_ = std::make_unique<WorkerPool>(threads);
+}
+
+unsigned World::threads() const { return pool_->size(); }
+
+unsigned World::hardware_threads() { return tumble::hardware_threads(); }
 
 void World::set_integrator(Integrator integrator) { scene_.world.integrator = integrator; }
 

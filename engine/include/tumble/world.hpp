@@ -6,7 +6,8 @@
 ///   for (int i = 0; i < 300; ++i) world.step();
 ///   world.apply_impulse(0, {0, 5, 0}, world.body(0).s.x);
 ///
-/// Not thread-safe: one thread owns a World (the server's simulation thread). No I/O, no
+/// Not thread-safe: one thread owns a World (the server's simulation thread); with
+/// set_threads it lends each step to worker threads of its own. No I/O, no
 /// exceptions inside step(); bad input is refused at the entry points.
 #include <cstdint>
 #include <memory>
@@ -29,6 +30,8 @@ struct ContactCache;
 struct BroadPhaseCache;
 /// Per-step buffers of the stages.
 struct StepScratch;
+/// Worker threads of the stages.
+class WorkerPool;
 
 /// Thrown by World's entry points for input that names no body or is not finite.
 struct InvalidInput : std::invalid_argument {
@@ -63,6 +66,15 @@ class World {
   /// default: the two clock reads per stage cost about 0.5 µs a step on this project's
   /// machines, more than a lone body's whole step.
   void set_stage_timing(bool on);
+
+  /// Shares each step's independent work (bodies, pairs, contacts of one colour) among
+  /// `threads` threads, this one included; 0: one per core. Results are bit-identical for any
+  /// count. A new World steps on its owner's thread alone (1); a copy keeps the count.
+  void set_threads(unsigned threads);
+  /// Threads a step uses (≥ 1).
+  unsigned threads() const;
+  /// Cores of this machine (std::thread::hardware_concurrency, at least 1).
+  static unsigned hardware_threads();
 
   /// Switches the flight integrator from the next step on.
   void set_integrator(Integrator integrator);
@@ -106,6 +118,7 @@ class World {
   std::unique_ptr<ContactCache> cache_;       // warm-start contacts, sleeping islands
   std::unique_ptr<BroadPhaseCache> broad_;   // sweep orders, fat boxes (acceleration only)
   std::unique_ptr<StepScratch> scratch_;     // per-step buffers
+  std::unique_ptr<WorkerPool> pool_;         // threads of the stages (never copied)
 };
 
 }  // namespace tumble

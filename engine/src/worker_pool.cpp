@@ -1,0 +1,107 @@
+#include "worker_pool.hpp"
+
+#include <algorithm>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
+namespace tumble {
+namespace {
+
+// A step submits its jobs microseconds apart, and a futex wake-up costs a few microseconds
+// and a context switch: workers poll for a while (about 50 µs) before they sleep, as Box2D
+// v3's task system and Jolt's job system do between the jobs of a step.
+constexpr int kSpinRounds = 1 << 10;
+
+void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#else
+  std::this_thread::yield();
+#endif
+}
+
+}  // namespace
+
+unsigned hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+WorkerPool::WorkerPool(unsigned threads) {
+  const unsigned workers = threads > 1 ? threads - 1 : 0;
+  workers_.reserve(workers);
+  for (unsigned i = 0; i < workers; ++i) workers_.emplace_back([this] { worker_main(); });
+}
+
+WorkerPool::~WorkerPool() {
+  stop_ = true;
+  job_.fetch_add(kGeneration);
+  job_.notify_all();
+  for (std::thread& t : workers_) t.join();
+}
+
+// The caller publishes the job, takes chunks like any worker, closes the job to latecomers and
+// waits only for the workers inside it; only then may the job's fields change again.
+void WorkerPool::run(std::size_t n, std::size_t grain, Thunk thunk, void* fn) {
+  const std::size_t most = 4 * static_cast<std::size_t>(size());  // a few chunks per thread
+  chunk_ = std::max(grain, (n + most - 1) / most);
+  chunks_ = (n + chunk_ - 1) / chunk_;
+  thunk_ = thunk;
+  fn_ = fn;
+  n_ = n;
+  next_.store(0, std::memory_order_relaxed);
+  const std::uint64_t generation = (job_.load(std::memory_order_relaxed) >> 17) + 1;
+  job_.store(generation << 17);  // open, nobody inside; sequentially consistent with sleepers_
+  if (sleepers_.load() > 0) job_.notify_all();
+  work();
+  std::uint64_t state = job_.fetch_or(kClosed) | kClosed;
+  for (int spins = 0; (state & kInside) != 0; state = job_.load(std::memory_order_acquire)) {
+    if (++spins < kSpinRounds) {
+      cpu_relax();
+      continue;
+    }
+    caller_waiting_.store(true);
+    state = job_.load();
+    if ((state & kInside) != 0) job_.wait(state);
+    caller_waiting_.store(false);
+    state = job_.load(std::memory_order_acquire);
+  }
+}
+
+void WorkerPool::work() {
+  for (;;) {
+    const std::size_t c = next_.fetch_add(1, std::memory_order_relaxed);
+    if (c >= chunks_) return;
+    const std::size_t begin = c * chunk_;
+    thunk_(fn_, begin, std::min(n_, begin + chunk_));
+  }
+}
+
+void WorkerPool::worker_main() {
+  std::uint64_t seen = job_.load() & ~(kClosed | kInside);
+  for (;;) {
+    std::uint64_t state = job_.load(std::memory_order_acquire);
+    for (int spins = 0; (state & ~(kClosed | kInside)) == seen;
+         state = job_.load(std::memory_order_acquire)) {
+      if (++spins < kSpinRounds) {
+        cpu_relax();
+        continue;
+      }
+      sleepers_.fetch_add(1);  // sequentially consistent: either run() sees us or we see it
+      state = job_.load();
+      if ((state & ~(kClosed | kInside)) == seen) job_.wait(state);
+      sleepers_.fetch_sub(1);
+    }
+    if (stop_) return;
+    seen = state & ~(kClosed | kInside);
+    // Join unless the caller has closed the job (it finished without us).
+    while ((state & kClosed) == 0 && (state & ~(kClosed | kInside)) == seen &&
+           !job_.compare_exchange_weak(state, state + 1, std::memory_order_acquire))
+      ;
+    if ((state & kClosed) != 0 || (state & ~(kClosed | kInside)) != seen) continue;
+    work();
+    const std::uint64_t left = job_.fetch_sub(1) - 1;  // release: our chunks are visible
+    if ((left & kInside) == 0 && caller_waiting_.load()) job_.notify_all();
+  }
+}
+
+}  // namespace tumble

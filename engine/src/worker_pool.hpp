@@ -1,0 +1,73 @@
+#pragma once
+/// A small pool of worker threads for the stages of one World::step: `for_each` splits an
+/// index range into chunks that the caller and the workers take in turn. Results never depend
+/// on the thread count as long as each index writes only its own outputs (every stage that
+/// uses the pool is written that way), so a World steps bit-identically on 1 or N threads.
+/// One thread (the World's owner) submits work; the pool itself is not re-entrant.
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+namespace tumble {
+
+/// Worker threads that spin briefly between jobs (a step submits a few hundred small jobs in
+/// a row) and sleep on a futex otherwise. A worker that comes late finds the job done and
+/// skips it: the caller never waits for a thread that has not started, so a busy machine
+/// (more runnable threads than cores) slows a step down to one thread's pace, not below.
+/// Owned by one World; not copyable.
+class WorkerPool {
+ public:
+  /// A pool of `threads` − 1 workers plus the calling thread; threads ≥ 1 (1: no workers).
+  explicit WorkerPool(unsigned threads);
+  ~WorkerPool();
+  WorkerPool(const WorkerPool&) = delete;
+  WorkerPool& operator=(const WorkerPool&) = delete;
+
+  /// Threads that share a job, the caller included.
+  unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
+
+  /// Calls fn(begin, end) over [0, n) in chunks of at least `grain` indices, on this thread
+  /// and the workers; returns when every chunk is done. Runs inline when n ≤ grain or the
+  /// pool has no workers. Allocates nothing.
+  template <typename Fn>
+  void for_each(std::size_t n, std::size_t grain, Fn&& fn) {
+    if (n == 0) return;
+    if (workers_.empty() || n <= grain) return fn(std::size_t{0}, n);
+    run(n, grain, &call<Fn>, &fn);
+  }
+
+ private:
+  using Thunk = void (*)(void*, std::size_t, std::size_t);
+  template <typename Fn>
+  static void call(void* fn, std::size_t begin, std::size_t end) {
+    (*static_cast<Fn*>(fn))(begin, end);
+  }
+  void run(std::size_t n, std::size_t grain, Thunk thunk, void* fn);
+  void work();
+  void worker_main();
+
+  std::vector<std::thread> workers_;
+  // The job: written by the caller while no worker has joined, read by workers that joined it.
+  Thunk thunk_ = nullptr;
+  void* fn_ = nullptr;
+  std::size_t n_ = 0;
+  std::size_t chunk_ = 0;
+  std::size_t chunks_ = 0;
+  alignas(64) std::atomic<std::size_t> next_{0};  // next chunk to take
+  // The job's generation (bits 17 and up), whether it is closed to newcomers (bit 16) and how
+  // many workers are inside it (bits 0–15). One word, so that joining is one compare-exchange.
+  alignas(64) std::atomic<std::uint64_t> job_{kClosed};
+  std::atomic<unsigned> sleepers_{0};     // workers asleep on job_
+  std::atomic<bool> caller_waiting_{false};  // the caller asleep on job_
+  bool stop_ = false;
+  static constexpr std::uint64_t kClosed = std::uint64_t{1} << 16;
+  static constexpr std::uint64_t kInside = kClosed - 1;
+  static constexpr std::uint64_t kGeneration = std::uint64_t{1} << 17;
+};
+
+/// Threads a World uses when asked for "as many as there are cores".
+unsigned hardware_threads();
+
+}  // namespace tumble
