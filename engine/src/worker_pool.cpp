@@ -33,9 +33,12 @@ WorkerPool::WorkerPool(unsigned threads) {
 }
 
 WorkerPool::~WorkerPool() {
-  stop_ = true;
+  stop_.store(true);
   job_.fetch_add(kGeneration);
-  job_.notify_all();
+  {
+    std::lock_guard lock(mutex_);
+  }
+  work_ready_.notify_all();
   for (std::thread& t : workers_) t.join();
 }
 
@@ -51,7 +54,10 @@ void WorkerPool::run(std::size_t n, std::size_t grain, Thunk thunk, void* fn) {
   next_.store(0, std::memory_order_relaxed);
   const std::uint64_t generation = (job_.load(std::memory_order_relaxed) >> 17) + 1;
   job_.store(generation << 17);  // open, nobody inside; sequentially consistent with sleepers_
-  if (sleepers_.load() > 0) job_.notify_all();
+  if (sleepers_.load() > 0) {
+    { std::lock_guard lock(mutex_); }  // a sleeper is now either waiting or sees the new job
+    work_ready_.notify_all();
+  }
   work();
   std::uint64_t state = job_.fetch_or(kClosed) | kClosed;
   for (int spins = 0; (state & kInside) != 0; state = job_.load(std::memory_order_acquire)) {
@@ -59,9 +65,9 @@ void WorkerPool::run(std::size_t n, std::size_t grain, Thunk thunk, void* fn) {
       cpu_relax();
       continue;
     }
-    caller_waiting_.store(true);
-    state = job_.load();
-    if ((state & kInside) != 0) job_.wait(state);
+    std::unique_lock lock(mutex_);
+    caller_waiting_.store(true);  // sequentially consistent: pairs with the worker's leaving
+    job_left_.wait(lock, [&] { return (job_.load() & kInside) == 0; });
     caller_waiting_.store(false);
     state = job_.load(std::memory_order_acquire);
   }
@@ -80,18 +86,20 @@ void WorkerPool::worker_main() {
   std::uint64_t seen = job_.load() & ~(kClosed | kInside);
   for (;;) {
     std::uint64_t state = job_.load(std::memory_order_acquire);
-    for (int spins = 0; (state & ~(kClosed | kInside)) == seen;
+    for (int spins = 0; (state & ~(kClosed | kInside)) == seen && !stop_.load();
          state = job_.load(std::memory_order_acquire)) {
       if (++spins < kSpinRounds) {
         cpu_relax();
         continue;
       }
+      std::unique_lock lock(mutex_);
       sleepers_.fetch_add(1);  // sequentially consistent: either run() sees us or we see it
-      state = job_.load();
-      if ((state & ~(kClosed | kInside)) == seen) job_.wait(state);
+      work_ready_.wait(lock, [&] {
+        return (job_.load() & ~(kClosed | kInside)) != seen || stop_.load();
+      });
       sleepers_.fetch_sub(1);
     }
-    if (stop_) return;
+    if (stop_.load()) return;
     seen = state & ~(kClosed | kInside);
     // Join unless the caller has closed the job (it finished without us).
     while ((state & kClosed) == 0 && (state & ~(kClosed | kInside)) == seen &&
@@ -100,7 +108,10 @@ void WorkerPool::worker_main() {
     if ((state & kClosed) != 0 || (state & ~(kClosed | kInside)) != seen) continue;
     work();
     const std::uint64_t left = job_.fetch_sub(1) - 1;  // release: our chunks are visible
-    if ((left & kInside) == 0 && caller_waiting_.load()) job_.notify_all();
+    if ((left & kInside) == 0 && caller_waiting_.load()) {
+      { std::lock_guard lock(mutex_); }
+      job_left_.notify_all();
+    }
   }
 }
 

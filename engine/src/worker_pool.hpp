@@ -5,8 +5,10 @@
 /// uses the pool is written that way), so a World steps bit-identically on 1 or N threads.
 /// One thread (the World's owner) submits work; the pool itself is not re-entrant.
 #include <atomic>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -59,9 +61,16 @@ class WorkerPool {
   // The job's generation (bits 17 and up), whether it is closed to newcomers (bit 16) and how
   // many workers are inside it (bits 0–15). One word, so that joining is one compare-exchange.
   alignas(64) std::atomic<std::uint64_t> job_{kClosed};
-  std::atomic<unsigned> sleepers_{0};     // workers asleep on job_
-  std::atomic<bool> caller_waiting_{false};  // the caller asleep on job_
-  bool stop_ = false;
+  // Sleeping is a mutex and condition variables (std::atomic::wait of GCC 12 loses wake-ups
+  // here). A thread counts itself in sleepers_ or caller_waiting_ under the mutex before it
+  // checks its condition; the other side changes job_ first, then takes the mutex to notify
+  // only when someone may sleep.
+  std::mutex mutex_;
+  std::condition_variable work_ready_;       // job_ moved to a new generation (or stop)
+  std::condition_variable job_left_;         // the last worker left a closed job
+  std::atomic<unsigned> sleepers_{0};        // workers asleep on work_ready_
+  std::atomic<bool> caller_waiting_{false};  // the caller asleep on job_left_
+  std::atomic<bool> stop_{false};
   static constexpr std::uint64_t kClosed = std::uint64_t{1} << 16;
   static constexpr std::uint64_t kInside = kClosed - 1;
   static constexpr std::uint64_t kGeneration = std::uint64_t{1} << 17;

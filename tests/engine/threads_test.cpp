@@ -1,0 +1,94 @@
+// Worker threads (World::set_threads, engine/src/worker_pool.hpp): every index of a job runs
+// exactly once, and a World steps bit for bit the same on one thread as on several.
+#include <atomic>
+#include <cstring>
+#include <vector>
+
+#include "world_fixture.hpp"
+#include "worker_pool.hpp"
+
+namespace tumble {
+namespace {
+
+using testing::bundled;
+
+// Positions, orientations, momenta and activity of every body, compared byte for byte.
+void expect_identical(const World& a, const World& b) {
+  ASSERT_EQ(a.bodies().size(), b.bodies().size());
+  for (std::size_t i = 0; i < a.bodies().size(); ++i) {
+    const BodyState &x = a.bodies()[i].s, &y = b.bodies()[i].s;
+    ASSERT_EQ(std::memcmp(x.x.data(), y.x.data(), sizeof(double) * 3), 0) << "x of body " << i;
+    ASSERT_EQ(std::memcmp(x.R.data(), y.R.data(), sizeof(double) * 9), 0) << "R of body " << i;
+    ASSERT_EQ(std::memcmp(x.P.data(), y.P.data(), sizeof(double) * 3), 0) << "P of body " << i;
+    ASSERT_EQ(std::memcmp(x.L.data(), y.L.data(), sizeof(double) * 3), 0) << "L of body " << i;
+    ASSERT_EQ(a.bodies()[i].activity, b.bodies()[i].activity) << "activity of body " << i;
+  }
+  EXPECT_EQ(a.total_impacts(), b.total_impacts());
+}
+
+// Steps `scene` on 1, 2 and 3 threads with the same impulses (zero kicks that keep islands
+// awake, and one real kick) and checks after every step that the states agree.
+void expect_same_on_any_thread_count(const Scene& scene, int steps) {
+  std::vector<World> worlds;
+  for (unsigned threads : {1u, 2u, 3u}) {
+    worlds.emplace_back(scene);
+    worlds.back().set_threads(threads);
+    ASSERT_EQ(worlds.back().threads(), threads);
+  }
+  for (int i = 1; i <= steps; ++i) {
+    for (World& w : worlds) {
+      if (i % 15 == 0)
+        for (std::size_t b = 0; b < w.bodies().size(); b += 7) w.apply_impulse(BodyId(b), Vec3::Zero());
+      if (i == steps / 2) w.apply_impulse(0, Vec3(3.0, 1.0, -2.0), w.body(0).s.x + Vec3(0.1, 0.2, 0.0));
+      w.step();
+    }
+    for (std::size_t k = 1; k < worlds.size(); ++k) {
+      expect_identical(worlds[0], worlds[k]);
+      if (::testing::Test::HasFatalFailure()) FAIL() << "at step " << i << ", thread count " << k + 1;
+    }
+  }
+  EXPECT_GT(worlds[0].last_step().awake, 0u);
+}
+
+TEST(Threads, EveryIndexRunsOnce) {
+  for (unsigned threads : {1u, 2u, 4u}) {
+    WorkerPool pool(threads);
+    ASSERT_EQ(pool.size(), threads);
+    for (std::size_t n : {0, 1, 7, 100, 1000, 12345}) {
+      std::vector<std::atomic<int>> seen(n);
+      pool.for_each(n, 3, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) seen[i].fetch_add(1);
+      });
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(seen[i].load(), 1) << i << " of " << n;
+    }
+  }
+}
+
+// The pile: 1,000 boxes falling into one another (broad phase, narrow phase, big islands
+// whose contacts are solved colour by colour).
+TEST(Threads, PileIsBitIdenticalOnOneTwoAndThreeThreads) {
+  expect_same_on_any_thread_count(bundled("pile"), 90);
+}
+
+// The pyramid: one island of 210 boxes standing on the floor.
+TEST(Threads, PyramidIsBitIdenticalOnOneTwoAndThreeThreads) {
+  expect_same_on_any_thread_count(bundled("pyramid"), 30);
+}
+
+// Separated boxes: lone bodies flying with the scene's integrator and landing on the floor.
+TEST(Threads, SeparatedBoxesAreBitIdenticalOnOneTwoAndThreeThreads) {
+  expect_same_on_any_thread_count(bundled("many"), 240);
+}
+
+TEST(Threads, CopyKeepsTheThreadCountAndZeroMeansEveryCore) {
+  World a(bundled("tower"));
+  EXPECT_EQ(a.threads(), 1u);
+  a.set_threads(2);
+  World b = a;
+  EXPECT_EQ(b.threads(), 2u);
+  b.set_threads(0);
+  EXPECT_EQ(b.threads(), World::hardware_threads());
+}
+
+}  // namespace
+}  // namespace tumble
