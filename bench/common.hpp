@@ -21,6 +21,7 @@ struct Options {
   fs::path docs;       ///< Markdown file assembled from the sections.
   bool plots = true;   ///< Run gnuplot.
   int repeats = 3;     ///< Interleaved repetitions for timings (median taken).
+  unsigned threads = 1;  ///< `contact`: also time Tumble on this many threads (when above 1).
   /// `contact` and `stages`: run only these scenes (empty: all), e.g. {"pyramid_large"}. The
   /// section then says it is a partial run.
   std::vector<std::string> only;

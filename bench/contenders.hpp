@@ -24,10 +24,18 @@ struct Contender {
   std::function<std::unique_ptr<PeerWorld>(const tumble::Scene&, const PeerSetup&)> make;
   std::string keep_awake_note;  ///< How a kept-awake run keeps it awake, in words.
   bool sleeps = true;           ///< false: the engine has no sleeping (MuJoCo 2.2).
+  /// Threads a Tumble world steps on (World::set_threads). Above 1 the engine's work runs on
+  /// several threads, so a timing takes the wall clock instead of this thread's CPU time.
+  unsigned threads = 1;
 };
 
-/// Tumble first, then the peers found at build time; `with_rk4` adds MuJoCo with RK4.
-std::vector<Contender> contenders(bool with_rk4 = false);
+/// Tumble first (on one thread, then as "tumble-<n>t" on `tumble_threads` threads when that is
+/// above 1), then the peers found at build time; `with_rk4` adds MuJoCo with RK4.
+std::vector<Contender> contenders(bool with_rk4 = false, unsigned tumble_threads = 1);
+
+/// Seconds to charge a timing of `c` from now: this thread's CPU time, or the wall clock for
+/// a multi-threaded contender.
+double clock_of(const Contender& c);
 
 /// CPU seconds of `steps` steps of a fresh world (building it is not timed); NaN when the
 /// engine refused the scene (*why, if given, says why).

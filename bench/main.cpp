@@ -14,6 +14,8 @@
 #include <map>
 #include <optional>
 #include <sstream>
+
+#include "tumble/world.hpp"
 #include <sys/utsname.h>
 #include <thread>
 
@@ -125,6 +127,8 @@ std::optional<int> parse(int argc, char** argv, Invocation& inv) {
       "Markdown page assembled from the results")("no-plots", "skip gnuplot")(
       "repeats", po::value(&inv.o.repeats)->default_value(3),
       "interleaved repetitions of each timing (median)")(
+      "threads", po::value(&inv.o.threads)->default_value(tumble::World::hardware_threads()),
+      "contact: also time Tumble on this many threads (default: one per core; 1: only one)")(
       "only", po::value(&inv.only),
       "contact, stages: only these scenes, comma-separated (e.g. pyramid_large)");
   po::options_description all;
@@ -148,6 +152,10 @@ std::optional<int> parse(int argc, char** argv, Invocation& inv) {
   inv.o.plots = !vm.count("no-plots");
   if (inv.o.quick) inv.o.repeats = std::min(inv.o.repeats, 1);
   inv.o.only = split_commas(inv.only);
+  if (inv.o.threads < 1 || inv.o.threads > 256) {
+    std::cerr << "--threads must be within [1, 256]\n" << visible << '\n';
+    return 2;
+  }
   inv.default_paths = vm["out"].defaulted() && vm["docs"].defaulted();
   return std::nullopt;
 }

@@ -27,6 +27,7 @@ struct Options {
   std::optional<std::string> toi;
   long every = 1;
   std::optional<std::string> csv;
+  unsigned threads = tumble::World::hardware_threads();
 };
 
 int usage_error(const std::string& message, const po::options_description& desc) {
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
       ("integrator", po::value<std::string>(), "euler|midpoint|rk4|symplectic_euler|splitting|exact")
       ("toi", po::value<std::string>(), "bisection|root")
       ("every", po::value(&o.every), "CSV row every N steps (default 1)")
+      ("threads", po::value(&o.threads), "threads per step (default: one per core); any count gives the same result")
       ("csv", po::value<std::string>(), "write body states to this CSV file");
   po::options_description hidden;
   hidden.add_options()("scene", po::value(&o.scene));
@@ -84,6 +86,7 @@ int main(int argc, char** argv) {
   if (!(std::isfinite(o.duration) && o.duration >= 0.0 && o.duration <= 1e7))
     return usage_error("--duration must be within [0, 1e7] s", desc);
   if (o.every < 1) return usage_error("--every must be >= 1", desc);
+  if (o.threads < 1 || o.threads > 256) return usage_error("--threads must be within [1, 256]", desc);
 
   tumble::Scene scene;
   try {
@@ -113,6 +116,7 @@ int main(int argc, char** argv) {
   }
 
   tumble::World world(scene);
+  world.set_threads(o.threads);
   const long steps = std::lround(o.duration / scene.world.dt);
   if (csv.is_open()) write_rows(csv, world);
   std::uint64_t body_steps = 0;
@@ -128,6 +132,7 @@ int main(int argc, char** argv) {
       {"integrator", std::string(tumble::to_string(scene.world.integrator))},
       {"toi", std::string(tumble::to_string(scene.world.toi))},
       {"steps", steps},
+      {"threads", world.threads()},
       {"bodies", world.bodies().size()},
       {"impacts", world.total_impacts()},
       {"awake", world.awake_count()},
