@@ -7,6 +7,8 @@
 #include <cctype>
 #include <sstream>
 
+#include "tumble/world.hpp"
+
 namespace po = boost::program_options;
 
 namespace tumble::server {
@@ -34,6 +36,8 @@ po::options_description describe() {
        "with --token: also require it on GETs (but /api/health) and on /ws")
       ("max-connections", po::value<int>()->default_value(512),
        "most open connections, HTTP and WebSocket (1-100000); beyond: 503")
+      ("sim-threads", po::value<int>()->default_value(static_cast<int>(World::hardware_threads())),
+       "threads of each physics step (1-256; default: one per core); results are the same for any count")
       ("step-budget-ms", po::value<int>()->default_value(5000),
        "wall-time budget of one POST /api/step, ms (10-600000)")
       ("viewer-timeout-ms", po::value<int>()->default_value(15000),
@@ -107,6 +111,8 @@ ParsedOptions parse_options(int argc, const char* const argv[]) {
   o.max_connections = vm["max-connections"].as<int>();
   if (o.max_connections < 1 || o.max_connections > 100000)
     return bad("--max-connections must be in 1..100000", d);
+  o.sim_threads = vm["sim-threads"].as<int>();
+  if (o.sim_threads < 1 || o.sim_threads > 256) return bad("--sim-threads must be in 1..256", d);
   o.step_budget_ms = vm["step-budget-ms"].as<int>();
   if (o.step_budget_ms < 10 || o.step_budget_ms > 600000)
     return bad("--step-budget-ms must be in 10..600000", d);

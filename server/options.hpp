@@ -15,6 +15,7 @@ struct ServerOptions {
   int render_ms = 20;                  ///< Interval between WebSocket frames, ms.
   std::filesystem::path web_root;      ///< Directory of the viewer's static files.
   int threads = 2;                     ///< I/O threads (the simulation has its own).
+  int sim_threads = 1;                 ///< Threads of each physics step (World::set_threads).
   std::string token;                   ///< Bearer token for POSTs; empty: none required.
   int max_viewers = 64;                ///< Most WebSocket viewers at once.
   std::string allowed_origin;          ///< Origin allowed besides the server's own; "*": any.

@@ -30,10 +30,12 @@ void complete(Command& command, CommandResult result) {
 
 }  // namespace
 
-SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_command_budget)
+SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_command_budget,
+                 unsigned sim_threads)
     : metrics_(metrics),
       world_(std::make_unique<World>(std::move(scene))),
       step_command_budget_(step_command_budget) {
+  world_->set_threads(sim_threads);
   new_scene_info();
   anchor(Clock::now());
   publish(Change::restart);
@@ -223,6 +225,7 @@ CommandResult SimLoop::reset(ResetCommand& c) {
   std::unique_ptr<World> world;
   try {
     world = std::make_unique<World>(std::move(scene));
+    world->set_threads(world_->threads());
   } catch (const InvalidInput& e) {
     // The engine names the field first ("bodies: more than 65024 pairs …"): no change here.
     const std::string what = e.what();

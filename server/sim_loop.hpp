@@ -68,9 +68,11 @@ class SimLoop {
   static constexpr double kRtfMinWindow = 0.05;
 
   /// Builds the world (throws tumble::InvalidInput for an invalid scene) and publishes its
-  /// first snapshot. The loop does not run until start().
+  /// first snapshot. The loop does not run until start(). Each step runs on `sim_threads`
+  /// threads (this loop's thread and workers of the World's own; the same result for any count).
   SimLoop(Scene scene, Metrics& metrics,
-          std::chrono::milliseconds step_command_budget = std::chrono::seconds(5));
+          std::chrono::milliseconds step_command_budget = std::chrono::seconds(5),
+          unsigned sim_threads = 1);
   /// Stops the thread.
   ~SimLoop();
   SimLoop(const SimLoop&) = delete;

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <vector>
 
+#include "tumble/world.hpp"
+
 namespace tumble::server {
 namespace {
 
@@ -36,6 +38,24 @@ TEST(Options, Defaults) {
   EXPECT_EQ(p.options->step_budget_ms, 5000);
   EXPECT_EQ(p.options->viewer_timeout_ms, 15000);
   EXPECT_EQ(p.options->read_budget, 20000);
+  EXPECT_EQ(p.options->sim_threads, static_cast<int>(World::hardware_threads()));
+}
+
+// --sim-threads: the threads of each physics step, 1..256; also from TUMBLE_SIM_THREADS.
+TEST(Options, SimThreads) {
+  const ParsedOptions p = parse({"--sim-threads", "3"});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_EQ(p.options->sim_threads, 3);
+  for (const char* bad : {"0", "257", "two"}) {
+    const ParsedOptions r = parse({"--sim-threads", bad});
+    EXPECT_FALSE(r.options) << bad;
+    EXPECT_EQ(r.exit_code, 2) << bad;
+    EXPECT_NE(r.message.find("sim-threads"), std::string::npos) << r.message;
+  }
+  EnvVar env("TUMBLE_SIM_THREADS", "1");
+  const ParsedOptions e = parse({});
+  ASSERT_TRUE(e.options) << e.message;
+  EXPECT_EQ(e.options->sim_threads, 1);
 }
 
 TEST(Options, HardeningLimits) {
