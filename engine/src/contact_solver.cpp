@@ -30,7 +30,9 @@ class Solver {
   Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch,
          WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
-        rows_(scratch.rows), fixed_(scratch.fixed), order_(scratch.order) {
+        rows_(scratch.rows), fixed_(scratch.fixed), order_(scratch.order),
+        waves_(scratch.waves), wave_of_(scratch.wave_of), wave_start_(scratch.wave_start),
+        wave_order_(scratch.wave_order) {
     index_.resize(bodies.size(), -1);
     fixed_ = SolverBody{};
     sb_.resize(ids.size());
@@ -113,7 +115,9 @@ class Solver {
   }
 
   int impact(Contact& c, const Vec3& gravity, double dt);
-  void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt);
+  void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
+                         WorkerPool& pool);
+  void push_up(Contact& c, const Vec3& up, double dt);
   /// K = D S Dᵀ, K_ij = n·(change of the relative normal velocity at point i per unit impulse
   /// at j), 1/kg; a or b null: that body is held fixed.
   static NormalSystem normal_system_of(const Contact& c, const SolverBody* a,
@@ -132,8 +136,10 @@ class Solver {
   static void push(SolverBody& a, SolverBody& b, const Vec3& d, const PointRows& r, int k,
                    double j) {
     if (j == 0.0) return;
-    a.v -= (a.inv_mass * j) * d;
-    a.w -= j * r.inv_a[k];
+    if (a.inv_mass > 0.0) {  // not the floor, which contacts of one colour share
+      a.v -= (a.inv_mass * j) * d;
+      a.w -= j * r.inv_a[k];
+    }
     b.v += (b.inv_mass * j) * d;
     b.w += j * r.inv_b[k];
   }
@@ -156,6 +162,10 @@ class Solver {
   std::vector<ContactRows>& rows_;  // solver rows of each contact
   SolverBody& fixed_;               // the floor: absorbs impulses without moving
   std::vector<std::pair<double, std::uint32_t>>& order_;
+  std::vector<std::uint32_t>& waves_;       // latest shock-propagation wave of each body
+  std::vector<std::uint32_t>& wave_of_;     // wave of each contact in order_
+  std::vector<std::uint32_t>& wave_start_;  // start of each wave in wave_order_
+  std::vector<std::uint32_t>& wave_order_;  // contacts, wave by wave
 };
 
 // The collision pass of Guendelman, Bridson & Fedkiw 2003 (§5), with each contact's impact
@@ -286,7 +296,13 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
 // has built its impulses, and a heavy body on a light one cannot crush it. The sweep only
 // pushes (never pulls) and only where a contact still approaches, so an impact already
 // resolved exactly, or a scene without gravity (no "up"), is untouched.
-void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt) {
+//
+// The sweep is ordered, but a contact depends only on the earlier contacts that share one of
+// its bodies: each contact's wave is one more than the latest wave of its bodies, and the
+// contacts of one wave touch disjoint bodies. Waves run in turn, each shared among the pool's
+// threads: every body sees the same updates in the same order as in the ordered sweep.
+void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
+                               WorkerPool& pool) {
   constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
   const double g = gravity.norm();
   if (g == 0.0) return;
@@ -297,34 +313,63 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   std::vector<std::pair<double, std::uint32_t>>& order = order_;
   order.clear();
   for (std::size_t i = 0; i < contacts.size(); ++i)
-    order.emplace_back(std::min(height(contacts[i].a), height(contacts[i].b)),
-                       static_cast<std::uint32_t>(i));
+    // A contact whose normal is nearly horizontal supports nothing and is left to the
+    // iterations.
+    if (std::abs(contacts[i].normal.dot(up)) >= kSupportCosine)
+      order.emplace_back(std::min(height(contacts[i].a), height(contacts[i].b)),
+                         static_cast<std::uint32_t>(i));
   std::sort(order.begin(), order.end());
-  for (const auto& [h, i] : order) {
-    Contact& c = contacts[i];
-    // The supporting body is the one the normal points away from; a contact whose normal is
-    // nearly horizontal supports nothing and is left to the iterations.
-    const double lift = c.normal.dot(up);
-    if (std::abs(lift) < kSupportCosine) continue;
-    const bool a_lower = lift > 0.0;
-    SolverBody* a = a_lower ? nullptr : body(c.a);
-    SolverBody* b = a_lower ? body(c.b) : nullptr;
-    const int n = c.count;
-    PointVector vn(n), target(n);
-    bool approaching = false;
-    for (int k = 0; k < n; ++k) {
-      const ContactPoint& p = c.points[k];
-      vn(k) = (point_velocity(body(c.b), p.rb) - point_velocity(body(c.a), p.ra)).dot(c.normal);
-      target(k) = target_of(p, dt);
-      approaching = approaching || vn(k) < target(k) - 1e-9;
-    }
-    if (!approaching) continue;
-    const NormalSystem sys = normal_system_of(c, a, b);
-    ActiveSetCache cache(sys);
-    const PointVector impulse = solve_active_set(cache, vn, target);
-    for (int k = 0; k < n; ++k)
-      if (impulse(k) > 0.0) apply(a, b, c.points[k].ra, c.points[k].rb, impulse(k) * c.normal);
+  waves_.assign(sb_.size(), 0);
+  wave_of_.resize(order.size());
+  std::uint32_t last = 0;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Contact& c = contacts[order[k].second];
+    const std::uint32_t wa = c.a == kStaticBody ? 0 : waves_[index_[c.a]];
+    const std::uint32_t wave = std::max(wa, waves_[index_[c.b]]) + 1;
+    if (c.a != kStaticBody) waves_[index_[c.a]] = wave;
+    waves_[index_[c.b]] = wave;
+    wave_of_[k] = wave;
+    last = std::max(last, wave);
   }
+  // Counting sort of the contacts by wave (stable: height order within a wave).
+  wave_start_.assign(last + 2, 0);
+  for (std::uint32_t w : wave_of_) ++wave_start_[w + 1];
+  for (std::size_t w = 1; w < wave_start_.size(); ++w) wave_start_[w] += wave_start_[w - 1];
+  wave_order_.resize(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    wave_order_[wave_start_[wave_of_[k]]++] = order[k].second;
+  for (std::size_t w = wave_start_.size() - 1; w > 0; --w) wave_start_[w] = wave_start_[w - 1];
+  wave_start_[0] = 0;
+  for (std::uint32_t w = 1; w <= last; ++w) {
+    const std::size_t begin = wave_start_[w], end = wave_start_[w + 1];
+    pool.for_each(end - begin, 16, [&](std::size_t from, std::size_t to) {
+      for (std::size_t k = begin + from; k < begin + to; ++k)
+        push_up(contacts[wave_order_[k]], up, dt);
+    });
+  }
+}
+
+/// One contact of shock propagation: the lower body held fixed, the upper one alone takes the
+/// approach the iterations left.
+void Solver::push_up(Contact& c, const Vec3& up, double dt) {
+  const bool a_lower = c.normal.dot(up) > 0.0;
+  SolverBody* a = a_lower ? nullptr : body(c.a);
+  SolverBody* b = a_lower ? body(c.b) : nullptr;
+  const int n = c.count;
+  PointVector vn(n), target(n);
+  bool approaching = false;
+  for (int k = 0; k < n; ++k) {
+    const ContactPoint& p = c.points[k];
+    vn(k) = (point_velocity(body(c.b), p.rb) - point_velocity(body(c.a), p.ra)).dot(c.normal);
+    target(k) = target_of(p, dt);
+    approaching = approaching || vn(k) < target(k) - 1e-9;
+  }
+  if (!approaching) return;
+  const NormalSystem sys = normal_system_of(c, a, b);
+  ActiveSetCache cache(sys);
+  const PointVector impulse = solve_active_set(cache, vn, target);
+  for (int k = 0; k < n; ++k)
+    if (impulse(k) > 0.0) apply(a, b, c.points[k].ra, c.points[k].rb, impulse(k) * c.normal);
 }
 
 NormalSystem Solver::normal_system_of(const Contact& c, const SolverBody* a,
@@ -366,8 +411,10 @@ void Solver::solve_position(Contact& c, std::size_t index, const SolverSettings&
     const double delta = next - p.pseudo_impulse;
     p.pseudo_impulse = next;
     if (delta == 0.0) continue;
-    a.vp -= (a.inv_mass * delta) * n;
-    a.wp -= delta * r.inv_a[0];
+    if (a.inv_mass > 0.0) {  // not the floor, which contacts of one colour share
+      a.vp -= (a.inv_mass * delta) * n;
+      a.wp -= delta * r.inv_a[0];
+    }
     b.vp += (b.inv_mass * delta) * n;
     b.wp += delta * r.inv_b[0];
   }
@@ -491,7 +538,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   sweep(colours, contacts, pool, [&](Contact& c, std::size_t i) { solver.warm_start(c, i); });
   for (int it = 0; it < settings.velocity_iterations; ++it)
     sweep(colours, contacts, pool, [&](Contact& c, std::size_t i) { solver.solve_velocity(c, i, dt); });
-  if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt);
+  if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt, pool);
   for (int it = 0; it < settings.position_iterations; ++it)
     sweep(colours, contacts, pool,
           [&](Contact& c, std::size_t i) { solver.solve_position(c, i, settings, dt); });
