@@ -40,7 +40,7 @@ Server::Server(ServerOptions options, Scene scene)
       read_budget_(options_.read_budget, options_.read_budget),
       sim_(std::move(scene), metrics_, std::chrono::milliseconds(options_.step_budget_ms)),
       ioc_(options_.threads),
-      broadcaster_(ioc_, sim_, std::chrono::milliseconds(options_.render_ms),
+      broadcaster_(ioc_, sim_, metrics_, std::chrono::milliseconds(options_.render_ms),
                    static_cast<std::size_t>(options_.max_viewers)),
       ctx_{options_,  canonical_root(options_.web_root), sim_, broadcaster_, metrics_,
            connections_, read_budget_} {
