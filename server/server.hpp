@@ -67,6 +67,7 @@ class Server {
   Metrics metrics_;
   ConnectionCount connections_;
   ReadBudget read_budget_;
+  StaticCache static_cache_;
   int web_root_fd_ = -1;
   SimLoop sim_;
   boost::asio::io_context ioc_;

@@ -1,6 +1,6 @@
-// Heads-up display: connection state, sim time, real-time factor, frame rates, dropped frames,
-// body activity counts, and short error toasts. Also keeps the statistics it shows.
-import { Activity } from './protocol.js';
+// Heads-up display: connection state, sim time, real-time factor, frame rates, bytes/s
+// received, lag behind the server, dropped frames, body activity counts, and short error
+// toasts. Also keeps the statistics it shows.
 
 /** Wall-clock window over which the drawing rate is measured, ms. */
 const kRateWindowMs = 1000;
@@ -30,13 +30,18 @@ export class Hud {
     this.simTime = 0;
     this.paused = false;
     this.framesReceived = 0;   // binary frames received since the page loaded
-    this.dropped = 0;          // frames the server sent that never reached us (frame-number gaps)
+    this.dropped = 0;          // frames the server skipped for this page (its status message)
+    this.droppedBefore = 0;    // ... on earlier connections
     this.lastFrameNumber = null;
+    this.latestAt = 0;         // wall ms when the newest frame arrived
+    this.shownTime = 0;        // sim time of the state drawn last, s
+    this.lag = 0;              // estimated server sim time minus shownTime, s
+    this.byteSamples = [];     // [wall ms, bytes received so far]
     this.counts = { awake: 0, asleep: 0, frozen: 0 };
     this.frameSamples = [];    // [wall ms, sim time s] of recent frames
     this.renderTimes = [];     // wall ms of recent animation frames
     this.lastRefresh = 0;
-    this.serverRtf = null;     // from GET /api/state
+    this.serverRtf = null;     // from the stream's status message
     this.serverRtfAt = 0;      // wall ms when it came
   }
 
@@ -46,6 +51,7 @@ export class Hud {
     if (state === 'open') {
       // A new connection may be a restarted server whose frame counter starts again.
       this.lastFrameNumber = null;
+      this.droppedBefore = this.dropped;
       this.frameSamples.length = 0;
     }
     this.refresh(performance.now(), true);
@@ -64,29 +70,36 @@ export class Hud {
   /** Records a decoded frame received at wall time `now` (ms). */
   onFrame(frame, now) {
     this.framesReceived += 1;
-    if (this.lastFrameNumber !== null) {
-      const gap = (frame.frame - this.lastFrameNumber - 1) >>> 0; // u32 wrap-around safe
-      if (gap > 0 && gap < 1e6) this.dropped += gap;
-    }
     this.lastFrameNumber = frame.frame;
     if (frame.time < this.simTime) this.frameSamples.length = 0;
     this.simTime = frame.time;
+    this.latestAt = now;
     this.paused = frame.paused;
-    let asleep = 0, frozen = 0;
-    for (let i = 0; i < frame.count; i++) {
-      if (frame.activity[i] === Activity.asleep) asleep++;
-      else if (frame.activity[i] === Activity.frozen) frozen++;
-    }
-    this.counts = { awake: frame.count - asleep - frozen, asleep, frozen };
     this.frameSamples.push([now, frame.time]);
     trim(this.frameSamples, now, (s) => s[0], kFrameWindowMs);
   }
 
-  /** Records an animation frame at wall time `now` (ms) and refreshes the text now and then. */
-  onRender(now) {
+  /**
+   * Records an animation frame at wall time `now` (ms) that shows sim time `shownTime` (s),
+   * with `bytesReceived` so far; refreshes the text now and then.
+   */
+  onRender(now, shownTime, bytesReceived) {
     this.renderTimes.push(now);
     trim(this.renderTimes, now, (t) => t, kRateWindowMs);
+    this.byteSamples.push([now, bytesReceived]);
+    trim(this.byteSamples, now, (s) => s[0], kFrameWindowMs);
+    this.shownTime = shownTime;
+    // The server's sim time now: the newest frame's, advanced by the wall time since it came.
+    const serverTime = this.simTime + (this.paused ? 0 : ((now - this.latestAt) / 1000) * (this.serverRtf ?? 1));
+    this.lag = Math.max(0, serverTime - shownTime);
     this.refresh(now, false);
+  }
+
+  /** Message bytes received per second over the last few seconds. */
+  get bytesPerSecond() {
+    const s = this.byteSamples;
+    if (s.length < 2 || s[s.length - 1][0] <= s[0][0]) return 0;
+    return ((s[s.length - 1][1] - s[0][1]) * 1000) / (s[s.length - 1][0] - s[0][0]);
   }
 
   /** Frames per second drawn by the page. */
@@ -104,7 +117,7 @@ export class Hud {
   }
 
   /**
-   * Sim seconds per wall second: the server's own figure from GET /api/state when it is fresh,
+   * Sim seconds per wall second: the server's own figure from its status message when fresh,
    * else measured from the frames (0 while paused).
    */
   get realTimeFactor() {
@@ -116,8 +129,10 @@ export class Hud {
     return wall > 0 ? (s[s.length - 1][1] - s[0][1]) / wall : 0;
   }
 
-  /** Takes the server's view from GET /api/state (real-time factor, integrator). */
+  /** Takes the server's status message (real-time factor, integrator, counts, drops). */
   setServerState(state) {
+    if (Number.isFinite(state.awake)) this.counts = { awake: state.awake, asleep: state.asleep, frozen: state.frozen };
+    if (Number.isFinite(state.dropped)) this.dropped = this.droppedBefore + state.dropped;
     if (Number.isFinite(state.real_time_factor)) {
       this.serverRtf = state.real_time_factor;
       this.serverRtfAt = performance.now();
@@ -145,6 +160,8 @@ export class Hud {
     set(f.fps, `${this.renderFps.toFixed(0)}`);
     set(f.stream, live ? `${this.streamFps.toFixed(0)}` : '0');
     set(f.dropped, String(this.dropped));
+    set(f.bytes, live ? formatRate(this.bytesPerSecond) : '0 B/s');
+    set(f.lag, live ? `${(this.lag * 1000).toFixed(0)} ms` : '—');
     const c = this.counts;
     set(f.bodies, `${c.awake + c.asleep + c.frozen}`);
     set(f.activity, `${c.awake} awake · ${c.asleep} asleep${c.frozen ? ` · ${c.frozen} frozen` : ''}`);
@@ -159,6 +176,12 @@ export class Hud {
     this.toastBox.appendChild(el);
     setTimeout(() => el.remove(), 4000);
   }
+}
+
+function formatRate(bytesPerSecond) {
+  if (bytesPerSecond >= 1e6) return `${(bytesPerSecond / 1e6).toFixed(2)} MB/s`;
+  if (bytesPerSecond >= 1e3) return `${(bytesPerSecond / 1e3).toFixed(1)} kB/s`;
+  return `${bytesPerSecond.toFixed(0)} B/s`;
 }
 
 function set(elements, text) {

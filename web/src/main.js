@@ -1,10 +1,10 @@
 // Entry point: wires the stream to the viewer, HUD, energy plot and controls; runs the render loop.
 import { Viewer } from './viewer.js';
-import { StreamConnection, pollState, streamUrl } from './connection.js';
+import { StreamConnection, streamUrl } from './connection.js';
 import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
-import { sceneIntegrator, sceneName } from './protocol.js';
+import { BodyStates, sceneIntegrator, sceneName } from './protocol.js';
 
 const viewer = createViewer();
 const hud = new Hud(document.getElementById('hud'), document.getElementById('toasts'));
@@ -21,7 +21,9 @@ function createViewer() {
 }
 
 let currentScene = null; // name of the scene the meshes were built for
-let latestFrame = null;  // newest frame not drawn yet (older ones are simply superseded)
+const bodies = new BodyStates(); // every body's newest pose, updated by each frame on arrival
+let drawnFrame = null;   // number of the frame drawn last
+let drawnTime = 0;       // its sim time, s
 let framesDrawn = 0;
 
 const connection = new StreamConnection(streamUrl(), {
@@ -29,17 +31,25 @@ const connection = new StreamConnection(streamUrl(), {
     const name = sceneName(message.scene);
     viewer.setScene(message, { refit: name !== currentScene });
     currentScene = name;
-    latestFrame = null;
+    bodies.clear();
+    drawnFrame = null;
     plot.clear();
     hud.setScene(name, sceneIntegrator(message.scene));
     controls.setSceneName(name);
     controls.setIntegrator(sceneIntegrator(message.scene));
   },
+  onStatus(status) {
+    hud.setServerState(status);
+    if (status.integrator) controls.setIntegrator(status.integrator);
+  },
+  // Frames are applied as they arrive (cheap: only the bodies they carry); drawing takes
+  // whatever is newest when the browser next paints, so nothing waits in a queue.
   onFrame(frame) {
+    if (!bodies.apply(frame)) return false;
     hud.onFrame(frame, performance.now());
     plot.push(frame.time, frame.energy);
     controls.setPaused(frame.paused);
-    latestFrame = frame;
+    return true;
   },
   onState(state, detail) {
     hud.setConnection(state, detail);
@@ -50,30 +60,25 @@ const connection = new StreamConnection(streamUrl(), {
   },
 });
 
-// The server's real-time factor and integrator, twice a second. /api/state lists every body, so
-// large scenes skip it and the HUD measures the real-time factor from the frames instead.
-const kMaxPolledBodies = 2000;
-pollState({
-  everyMs: 500,
-  when: () => connection.state === 'open' && !document.hidden && viewer.bodyCount <= kMaxPolledBodies,
-  onState(state) {
-    hud.setServerState(state);
-    controls.setIntegrator(state.integrator);
-  },
-});
-
 function animate(now) {
   requestAnimationFrame(animate);
-  if (latestFrame && viewer.applyFrame(latestFrame)) framesDrawn += 1;
-  latestFrame = null;
+  if (bodies.frame !== null && bodies.frame !== drawnFrame && viewer.applyFrame(bodies)) {
+    drawnFrame = bodies.frame;
+    drawnTime = bodies.time;
+    framesDrawn += 1;
+  }
   viewer.render();
-  hud.onRender(now);
+  hud.onRender(now, drawnTime, connection.bytesReceived);
   plot.draw(now);
 }
 
 // A read-only window onto the page's state, for tests and the console.
 window.tumble = Object.freeze({
   get simTime() { return hud.simTime; },
+  get shownTime() { return drawnTime; },
+  get lag() { return hud.lag; },
+  get bytesPerSecond() { return hud.bytesPerSecond; },
+  get bytesReceived() { return connection.bytesReceived; },
   get frames() { return hud.framesReceived; },
   get framesDrawn() { return framesDrawn; },
   get dropped() { return hud.dropped; },
