@@ -1,7 +1,7 @@
 #pragma once
 /// The broadcaster: every --render-ms it quantises the latest Snapshot once into a FrameState
 /// (docs/protocol.md, version 2), publishes it in the shared FrameStore with a status every
-/// 0.5 s (or at once when paused, integrator or scene changed), and tells every WebSocket
+/// 1 s (or at once when paused, integrator or scene changed), and tells every WebSocket
 /// session that a newer frame exists. Sessions pull from the store at their own pace. No
 /// viewer, no work. Thread-safe.
 #include <chrono>
@@ -26,8 +26,8 @@ class WsSession;
 /// Frame timer plus the set of viewers (weak references, as in Beast's chat-multi example).
 class Broadcaster {
  public:
-  /// Frames between two periodic status messages (0.5 s at the default 20 ms).
-  static constexpr std::uint32_t kStatusEvery = 25;
+  /// Frames between two periodic status messages (1 s at the default 20 ms).
+  static constexpr std::uint32_t kStatusEvery = 50;
 
   /// Frames every `interval`; at most `max_viewers` sessions may join.
   Broadcaster(boost::asio::io_context& ioc, SimLoop& sim, Metrics& metrics,
