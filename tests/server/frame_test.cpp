@@ -71,8 +71,12 @@ TEST(Frame, KeyframeLayoutAndEngineVertices) {
   const Snapshot s = snapshot_of(world, nullptr);
   const auto state = make_frame_state(s, 42, s.time, nullptr);
   const std::string bytes = encode_frame(*state, nullptr);
-  // Header, then per body: format byte, 3 × int32 centre, 9 × int16 axes.
-  ASSERT_EQ(bytes.size(), kFrameHeaderBytes + 2u * (1 + 12 + 18));
+  // Header, then per body: format byte, 3 × int32 centre, 9 axes: int32 for box a (3 m:
+  // int16 would be coarser than 2⁻¹⁵ m), int16 for box b (0.5 m).
+  ASSERT_EQ(bytes.size(), kFrameHeaderBytes + (1 + 12 + 36) + (1 + 12 + 18));
+  EXPECT_TRUE(state->bodies[0].wide);
+  EXPECT_FALSE(state->bodies[1].wide);
+  EXPECT_EQ(state->bodies[1].exponent, 16);  // 0.25 m · 2¹⁷ would overflow int16
   EXPECT_EQ(bytes.substr(0, 4), "TMBL");
   const auto f = decode_frame(bytes);
   ASSERT_TRUE(f);
