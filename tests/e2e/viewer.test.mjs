@@ -42,11 +42,11 @@ async function until(what, probe, timeoutMs = 15000, everyMs = 150) {
 }
 
 /** Starts tumble-server; resolves with {child, port} once it prints its URL. */
-function startServer(port) {
+function startServer(port, scene = 'seed') {
   const env = { ...process.env };
   delete env.TUMBLE_TOKEN; // POSTs from the page carry no token
   delete env.TUMBLE_PORT;
-  const child = spawn(kServer, ['--port', String(port), '--scene', 'seed', '--web-root', path.join(kRepo, 'web')],
+  const child = spawn(kServer, ['--port', String(port), '--scene', scene, '--web-root', path.join(kRepo, 'web')],
     { env, stdio: ['ignore', 'pipe', 'pipe'] });
   let output = '';
   return new Promise((resolve, reject) => {
@@ -289,4 +289,127 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
     const seconds = (Date.now() - started) / 1000;
     t.diagnostic(`browser test took ${seconds.toFixed(1)} s` +
       (process.env.TUMBLE_E2E_SHOTS ? `; screenshots in ${shots}` : ''));
+  });
+
+/** A metric of GET /metrics. */
+async function metric(base, name) {
+  const text = await (await fetch(`${base}metrics`)).text();
+  const match = new RegExp(`^${name} (\\S+)$`, 'm').exec(text);
+  return match ? Number(match[1]) : NaN;
+}
+
+/** Bytes on the wire of every HTTP response the page loads (WebSocket excluded), via CDP. */
+async function countPageBytes(page, load) {
+  const cdp = await page.context().newCDPSession(page);
+  await cdp.send('Network.enable');
+  const http = new Set();
+  let bytes = 0, requests = 0, notModified = 0;
+  cdp.on('Network.responseReceived', (e) => {
+    if (e.type === 'WebSocket' || !e.response.url.startsWith('http')) return;
+    http.add(e.requestId);
+    if (e.response.status === 304) notModified++;
+  });
+  cdp.on('Network.loadingFinished', (e) => {
+    if (!http.has(e.requestId)) return;
+    bytes += e.encodedDataLength;
+    requests++;
+  });
+  await load();
+  await sleep(1000);
+  await cdp.detach();
+  return { bytes, requests, notModified };
+}
+
+test('pile: page weight, a slow page keeps up, bytes/s near zero asleep, a kicked box moves',
+  { timeout: 150000 }, async (t) => {
+    if (!fs.existsSync(kServer) || !fs.existsSync(kPlaywright) || !fs.existsSync(kChromium)) {
+      t.skip('server, playwright-core or chromium missing (see the first test)');
+      return;
+    }
+    const { chromium } = await import(pathToFileURL(kPlaywright).href);
+    const userData = fs.mkdtempSync(path.join(os.tmpdir(), 'tumble-e2e-chromium-'));
+    const server = await startServer(0, 'pile');
+    const base = `http://127.0.0.1:${server.port}/`;
+    let context;
+    t.after(async () => {
+      await context?.close().catch(() => {});
+      await stopServer(server.child);
+      fs.rmSync(userData, { recursive: true, force: true });
+    });
+    context = await chromium.launchPersistentContext(userData, {
+      executablePath: kChromium, headless: true, args: kChromiumArgs, viewport: kViewport,
+    });
+    const page = context.pages()[0] ?? await context.newPage();
+    page.setDefaultTimeout(20000);
+    const pageErrors = [];
+    page.on('pageerror', (e) => pageErrors.push(e.message));
+
+    await t.test('a first visit is at most 1 MB on the wire, a repeat visit at most 10 KB (304s)', async () => {
+      const first = await countPageBytes(page, () => page.goto(base));
+      await until('frames drawn', () => page.evaluate(() => window.tumble?.framesDrawn >= 2), 30000);
+      const repeat = await countPageBytes(page, () => page.goto(base));
+      await until('frames drawn again', () => page.evaluate(() => window.tumble?.framesDrawn >= 2), 30000);
+      t.diagnostic(`first visit ${first.bytes} B in ${first.requests} requests; repeat ${repeat.bytes} B, ` +
+        `${repeat.notModified} of ${repeat.requests} answered 304`);
+      assert.ok(first.bytes <= 1e6, `first visit ${first.bytes} B`);
+      assert.ok(repeat.bytes <= 10e3, `repeat visit ${repeat.bytes} B`);
+      assert.ok(repeat.notModified >= 5, 'the modules are revalidated, not downloaded again');
+    });
+
+    await t.test('with 200 ms of work per animation frame the page stays within 0.5 s of the server', async () => {
+      assert.ok((await fetch(`${base}api/reset`, { method: 'POST', body: '{"scene": "pile"}' })).ok);
+      await page.evaluate(() => {
+        window.slowPage = true;
+        const busy = () => {
+          const start = performance.now();
+          while (performance.now() - start < 200) { /* a slow device */ }
+          if (window.slowPage) requestAnimationFrame(busy);
+        };
+        requestAnimationFrame(busy);
+      });
+      await sleep(2000);
+      let worst = 0;
+      for (let i = 0; i < 12; i++) {
+        const shown = await page.evaluate(() => window.tumble.shownTime);
+        const server = await metric(base, 'tumble_sim_time_seconds');
+        worst = Math.max(worst, server - shown);
+        await sleep(250);
+      }
+      const hudLag = await page.evaluate(() => window.tumble.lag);
+      t.diagnostic(`worst lag ${(worst * 1000).toFixed(0)} ms; the HUD says ${(hudLag * 1000).toFixed(0)} ms`);
+      assert.ok(worst <= 0.5, `the slow page fell ${worst.toFixed(2)} s behind`);
+      assert.match(await hudText(page), /lag/);
+      const asked = Date.now();
+      assert.ok((await fetch(`${base}api/reset`, { method: 'POST', body: '{"scene": "many"}' })).ok);
+      await until('the slow page to show the new scene', () => page.evaluate(() => window.tumble.scene === 'many'), 5000, 50);
+      const switchMs = Date.now() - asked;
+      t.diagnostic(`scene switch shown after ${switchMs} ms`);
+      assert.ok(switchMs < 3000, `the scene switch took ${switchMs} ms to show`);
+      await page.evaluate(() => { window.slowPage = false; });
+      assert.ok((await fetch(`${base}api/reset`, { method: 'POST', body: '{"scene": "pile"}' })).ok);
+    });
+
+    await t.test('once the pile sleeps the HUD shows bytes/s near zero; a kicked box is seen moving', async () => {
+      await until('the page to show the pile', () => page.evaluate(() => window.tumble.scene === 'pile'));
+      await until('every body of the pile to sleep', async () => (await metric(base, 'tumble_bodies_awake')) === 0, 90000, 500);
+      await sleep(3500); // the HUD's rate window
+      const asleep = await page.evaluate(() => window.tumble.bytesPerSecond);
+      t.diagnostic(`asleep: the HUD shows ${asleep.toFixed(0)} bytes/s`);
+      assert.ok(asleep < 2000, `bytes/s while everything sleeps: ${asleep}`);
+      assert.match(await hudText(page), /received\s+\d+ B\/s/);
+      const state = await getJson(base, 'state');
+      let top = 0;
+      state.bodies.forEach((b, i) => { if (b.position[1] > state.bodies[top].position[1]) top = i; });
+      const before = await page.evaluate((i) => window.tumble.bodyScreenPosition(i), top);
+      const mass = (await getJson(base, 'scene')).bodies[top].mass ?? 1;
+      const kick = await fetch(`${base}api/impulse`, { method: 'POST',
+        body: JSON.stringify({ body: top, impulse: [0, 6 * mass, 0] }) });
+      assert.ok(kick.ok);
+      await until('the kicked box to move on screen', async () => {
+        const now = await page.evaluate((i) => window.tumble.bodyScreenPosition(i), top);
+        return Math.hypot(now.x - before.x, now.y - before.y) > 15;
+      }, 5000, 50);
+      await until('bytes to flow again', () => page.evaluate(() => window.tumble.bytesPerSecond > 200), 5000);
+    });
+    assert.deepEqual(pageErrors, [], 'no uncaught errors in the page');
   });
