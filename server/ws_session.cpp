@@ -3,6 +3,7 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 
+#include <algorithm>
 #include <random>
 
 #include <nlohmann/json.hpp>
@@ -141,6 +142,8 @@ void WsSession::on_client_message() {
       !j["frame"].is_number_unsigned())
     return;
   const auto frame = j["frame"].get<std::uint64_t>();
+  if (j.contains("window") && j["window"].is_number_unsigned())
+    ack_window_ = std::clamp<std::size_t>(j["window"].get<std::size_t>(), 1, kAckWindow);
   acking_ = true;
   while (!unacked_.empty() && unacked_.front() <= frame) unacked_.pop_front();
   if (!writing_) do_write();
@@ -162,7 +165,7 @@ void WsSession::on_notify() {
 }
 
 bool WsSession::busy() const {
-  return writing_ || (acking_ && unacked_.size() >= kAckWindow);
+  return writing_ || (acking_ && unacked_.size() >= ack_window_);
 }
 
 // Order: the first scene message, a newer scene's message (it resets the delta base), a new

@@ -5,8 +5,8 @@
 /// when its previous write is done it takes the newest frame, encoded against the frame it
 /// sent last (a keyframe when it has none of this scene). Nothing queues: a viewer that is
 /// slower than the frame rate gets fewer frames (each skipped one counts as dropped), never a
-/// stale one. A client that acknowledges frames (`{"type":"ack","frame":n}`) is also held to
-/// kAckWindow unacknowledged frames, so that a browser that reads its socket faster than it
+/// stale one. A client that acknowledges frames (`{"type":"ack","frame":n,"window":w}`) is
+/// also held to w ≤ kAckWindow unacknowledged frames, so that a browser that reads its socket faster than it
 /// can process gets no queue either. Other client messages are ignored (over 4 KiB: the
 /// connection is closed). Every half
 /// viewer timeout it sends a ping with a random payload; a viewer that has not echoed it in a
@@ -35,7 +35,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
   /// Largest message a client may send, bytes.
   static constexpr std::size_t kMaxClientMessage = 4096;
-  /// Frames an acknowledging client may have unacknowledged.
+  /// Frames an acknowledging client may have unacknowledged (it may ask for fewer).
   static constexpr std::size_t kAckWindow = 6;
   /// A frame that changes nothing is still sent this often (it carries the sim time), ms.
   static constexpr int kHeartbeatMs = 200;
@@ -89,6 +89,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   std::chrono::steady_clock::time_point last_frame_at_{};
   std::deque<std::uint32_t> unacked_;                 // Frames sent, not acknowledged.
   bool acking_ = false;                               // The client acknowledges frames.
+  std::size_t ack_window_ = kAckWindow;               // Its window (its last ack's).
   bool frame_waiting_ = false;                        // A newer frame exists, unsent.
   bool accepted_ = false;
   bool writing_ = false;

@@ -21,6 +21,7 @@ export class StreamConnection {
     this.onStatus = onStatus;
     this.onFrame = onFrame;
     this.bytesReceived = 0; // message payload bytes since the page loaded
+    this.ackWindow = () => 4; // frames the server may have in flight; main.js adapts it
     this.onState = onState;
     this.onError = onError ?? ((e) => console.warn(e));
     this.attempt = 0;
@@ -68,7 +69,7 @@ export class StreamConnection {
           this.bytesReceived += event.data.byteLength;
           const frame = decodeFrame(event.data);
           if (this.onFrame(frame) === false) throw new Error(`frame ${frame.frame} does not follow frame the page holds`);
-          socket.send(`{"type":"ack","frame":${frame.frame}}`);
+          socket.send(`{"type":"ack","frame":${frame.frame},"window":${this.ackWindow()}}`);
         }
       } catch (e) {
         this.onError(e);

@@ -60,7 +60,17 @@ const connection = new StreamConnection(streamUrl(), {
   },
 });
 
+// A page whose animation frames come slower than the stream's 20 ms (a busy main thread)
+// handles about one message per animation frame: every frame in flight is then one animation
+// frame of lag, so it asks for one frame at a time; a page that keeps up allows four (room for
+// the network's round trip).
+let lastAnimate = 0;
+let animateGapMs = 16;
+connection.ackWindow = () => (animateGapMs > 40 ? 1 : 4);
+
 function animate(now) {
+  animateGapMs = 0.8 * animateGapMs + 0.2 * Math.min(1000, now - (lastAnimate || now));
+  lastAnimate = now;
   requestAnimationFrame(animate);
   if (bodies.frame !== null && bodies.frame !== drawnFrame && viewer.applyFrame(bodies)) {
     drawnFrame = bodies.frame;
