@@ -279,6 +279,9 @@ void HttpSession::send_file(const Request& req, beast::file file, const StaticLo
     res.set(http::field::content_type, type);
     res.set(http::field::cache_control, "no-cache");
     res.set(http::field::etag, etag);
+    // Cross-origin isolation: the page may then share memory with its stream worker.
+    res.set("Cross-Origin-Opener-Policy", "same-origin");
+    res.set("Cross-Origin-Embedder-Policy", "require-corp");
     if (compressible(type)) res.set(http::field::vary, "Accept-Encoding");
     res.keep_alive(req.keep_alive());
   };

@@ -11,8 +11,9 @@ const kMaxDelayMs = 5000;
  * when the frame could not be applied (the connection is then reopened: a keyframe follows),
  * onState(state, detail). state is 'connecting' | 'open' | 'reconnecting'; detail.retryInMs is
  * set when reconnecting. Every frame handled is acknowledged to the server, which keeps at
- * most a few unacknowledged frames in flight: a page too busy to handle its messages gets
- * fewer frames instead of a growing queue (docs/protocol.md, "Pace").
+ * most a few unacknowledged frames in flight: a receiver too busy to handle its messages gets
+ * fewer frames instead of a growing queue (docs/protocol.md, "Pace"). The page runs it in a
+ * worker (stream_worker.js), whose event loop a busy page does not block.
  */
 export class StreamConnection {
   constructor(url, { onScene, onStatus, onFrame, onState, onError }) {
@@ -21,7 +22,7 @@ export class StreamConnection {
     this.onStatus = onStatus;
     this.onFrame = onFrame;
     this.bytesReceived = 0; // message payload bytes since the page loaded
-    this.ackWindow = () => 4; // frames the server may have in flight; main.js adapts it
+    this.ackWindow = () => 4; // frames the server may have in flight (docs/protocol.md, "ack")
     this.onState = onState;
     this.onError = onError ?? ((e) => console.warn(e));
     this.attempt = 0;

@@ -29,16 +29,16 @@ export class Hud {
     this.integrator = '';
     this.simTime = 0;
     this.paused = false;
-    this.framesReceived = 0;   // binary frames received since the page loaded
+    this.framesReceived = 0;   // binary frames the stream worker received since it started
+    this.bytesReceived = 0;    // message payload bytes it received
     this.dropped = 0;          // frames the server skipped for this page (its status message)
     this.droppedBefore = 0;    // ... on earlier connections
-    this.lastFrameNumber = null;
-    this.latestAt = 0;         // wall ms when the newest frame arrived
+    this.latestAt = 0;         // wall clock (ms since the epoch) when simTime was received
     this.shownTime = 0;        // sim time of the state drawn last, s
     this.lag = 0;              // estimated server sim time minus shownTime, s
-    this.byteSamples = [];     // [wall ms, bytes received so far]
+    this.byteSamples = [];     // [wall ms, bytes received so far, frames received so far]
     this.counts = { awake: 0, asleep: 0, frozen: 0 };
-    this.frameSamples = [];    // [wall ms, sim time s] of recent frames
+    this.frameSamples = [];    // [wall ms, sim time s] of recently drawn states
     this.renderTimes = [];     // wall ms of recent animation frames
     this.lastRefresh = 0;
     this.serverRtf = null;     // from the stream's status message
@@ -50,8 +50,7 @@ export class Hud {
     this.retryInMs = detail.retryInMs ?? 0;
     if (state === 'open') {
       // A new connection may be a restarted server whose frame counter starts again.
-      this.lastFrameNumber = null;
-      this.droppedBefore = this.dropped;
+        this.droppedBefore = this.dropped;
       this.frameSamples.length = 0;
     }
     this.refresh(performance.now(), true);
@@ -67,39 +66,54 @@ export class Hud {
     this.integrator = name;
   }
 
-  /** Records a decoded frame received at wall time `now` (ms). */
-  onFrame(frame, now) {
-    this.framesReceived += 1;
-    this.lastFrameNumber = frame.frame;
-    if (frame.time < this.simTime) this.frameSamples.length = 0;
-    this.simTime = frame.time;
-    this.latestAt = now;
-    this.paused = frame.paused;
-    this.frameSamples.push([now, frame.time]);
+  /**
+   * Takes the stream worker's counters: bytes and frames received, and the newest server sim
+   * time it heard of (s) with the wall-clock time it came (ms since the epoch).
+   */
+  onCounters({ bytes, frames, serverTime, receivedAt }) {
+    this.bytesReceived = bytes;
+    this.framesReceived = frames;
+    this.simTime = serverTime;
+    this.latestAt = receivedAt;
+  }
+
+  /** Records a newly drawn state (a StateReader) at the current animation frame. */
+  onDrawn(state) {
+    const now = performance.now();
+    if (state.time < this.shownTime) this.frameSamples.length = 0;
+    this.paused = state.paused;
+    this.frameSamples.push([now, state.time]);
     trim(this.frameSamples, now, (s) => s[0], kFrameWindowMs);
   }
 
   /**
-   * Records an animation frame at wall time `now` (ms) that shows sim time `shownTime` (s),
-   * with `bytesReceived` so far; refreshes the text now and then.
+   * Records an animation frame at wall time `now` (ms) that shows sim time `shownTime` (s);
+   * refreshes the text now and then.
    */
-  onRender(now, shownTime, bytesReceived) {
+  onRender(now, shownTime) {
     this.renderTimes.push(now);
     trim(this.renderTimes, now, (t) => t, kRateWindowMs);
-    this.byteSamples.push([now, bytesReceived]);
+    this.byteSamples.push([now, this.bytesReceived, this.framesReceived]);
     trim(this.byteSamples, now, (s) => s[0], kFrameWindowMs);
     this.shownTime = shownTime;
-    // The server's sim time now: the newest frame's, advanced by the wall time since it came.
-    const serverTime = this.simTime + (this.paused ? 0 : ((now - this.latestAt) / 1000) * (this.serverRtf ?? 1));
-    this.lag = Math.max(0, serverTime - shownTime);
+    this.lag = this.lagAt(now);
     this.refresh(now, false);
+  }
+
+  /**
+   * Sim seconds the state on screen is behind the server at page time `now` (ms): the newest
+   * sim time the stream worker received, advanced by the wall time since (at the server's
+   * real-time factor), minus the sim time of the state drawn.
+   */
+  lagAt(now) {
+    const since = Math.max(0, performance.timeOrigin + now - this.latestAt) / 1000;
+    const serverTime = this.simTime + (this.paused ? 0 : since * (this.serverRtf ?? 1));
+    return Math.max(0, serverTime - this.shownTime);
   }
 
   /** Message bytes received per second over the last few seconds. */
   get bytesPerSecond() {
-    const s = this.byteSamples;
-    if (s.length < 2 || s[s.length - 1][0] <= s[0][0]) return 0;
-    return ((s[s.length - 1][1] - s[0][1]) * 1000) / (s[s.length - 1][0] - s[0][0]);
+    return this.#sampleRate(1);
   }
 
   /** Frames per second drawn by the page. */
@@ -107,13 +121,15 @@ export class Hud {
     return rate(this.renderTimes.length, this.renderTimes[0], this.renderTimes[this.renderTimes.length - 1]);
   }
 
-  /** Frames per second received from the server over the last window (bursts do not inflate it). */
+  /** Frames per second received by the stream worker over the last few seconds. */
   get streamFps() {
-    const now = performance.now();
-    let n = 0;
-    for (const [wall] of this.frameSamples) if (now - wall <= kFrameWindowMs) n++;
-    const span = this.frameSamples.length ? Math.min(kFrameWindowMs, Math.max(kRateWindowMs, now - this.frameSamples[0][0])) : kFrameWindowMs;
-    return (n * 1000) / span;
+    return this.#sampleRate(2);
+  }
+
+  #sampleRate(column) {
+    const s = this.byteSamples;
+    if (s.length < 2 || s[s.length - 1][0] <= s[0][0]) return 0;
+    return ((s[s.length - 1][column] - s[0][column]) * 1000) / (s[s.length - 1][0] - s[0][0]);
   }
 
   /**

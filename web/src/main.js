@@ -1,10 +1,11 @@
 // Entry point: wires the stream to the viewer, HUD, energy plot and controls; runs the render loop.
 import { Viewer } from './viewer.js';
-import { StreamConnection, streamUrl } from './connection.js';
+import { streamUrl } from './connection.js';
+import { StateReader } from './shared_state.js';
 import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
-import { BodyStates, sceneIntegrator, sceneName } from './protocol.js';
+import { sceneIntegrator, sceneName } from './protocol.js';
 
 const viewer = createViewer();
 const hud = new Hud(document.getElementById('hud'), document.getElementById('toasts'));
@@ -21,64 +22,73 @@ function createViewer() {
 }
 
 let currentScene = null; // name of the scene the meshes were built for
-const bodies = new BodyStates(); // every body's newest pose, updated by each frame on arrival
+let state = null;        // StateReader of the worker's newest state for this scene
 let drawnFrame = null;   // number of the frame drawn last
 let drawnTime = 0;       // its sim time, s
 let framesDrawn = 0;
+let connectionState = 'connecting';
+let connects = 0;
+let pulling = false;     // a copy of the state was asked for (page not cross-origin isolated)
 
-const connection = new StreamConnection(streamUrl(), {
-  onScene(message) {
+// The stream lives in a worker: it applies every frame as it arrives, whatever this thread is
+// doing, and the animation loop below draws only the newest state (shared_state.js).
+const worker = new Worker(new URL('./stream_worker.js', import.meta.url), { type: 'module' });
+const handlers = {
+  scene({ message }) {
     const name = sceneName(message.scene);
     viewer.setScene(message, { refit: name !== currentScene });
     currentScene = name;
-    bodies.clear();
+    state = null;
     drawnFrame = null;
     plot.clear();
     hud.setScene(name, sceneIntegrator(message.scene));
     controls.setSceneName(name);
     controls.setIntegrator(sceneIntegrator(message.scene));
   },
-  onStatus(status) {
-    hud.setServerState(status);
-    if (status.integrator) controls.setIntegrator(status.integrator);
+  buffers({ buffers, update }) {
+    pulling = false;
+    if (update && state) state.attach(buffers);
+    else if (!update) state = new StateReader(buffers);
   },
-  // Frames are applied as they arrive (cheap: only the bodies they carry); drawing takes
-  // whatever is newest when the browser next paints, so nothing waits in a queue.
-  onFrame(frame) {
-    if (!bodies.apply(frame)) return false;
-    hud.onFrame(frame, performance.now());
-    plot.push(frame.time, frame.energy);
-    controls.setPaused(frame.paused);
-    return true;
+  status({ message }) {
+    hud.setServerState(message);
+    if (message.integrator) controls.setIntegrator(message.integrator);
   },
-  onState(state, detail) {
-    hud.setConnection(state, detail);
-    if (state === 'open' && connection.connects > 1) controls.loadSceneList();
+  connection({ state: s, detail, connects: n }) {
+    connectionState = s;
+    connects = n;
+    hud.setConnection(s, detail);
+    if (s === 'open' && n > 1) controls.loadSceneList();
   },
-  onError(error) {
-    console.warn('tumble stream:', error);
+  error({ message }) {
+    console.warn('tumble stream:', message);
   },
-});
+};
+worker.onmessage = ({ data }) => handlers[data?.type]?.(data);
+worker.postMessage({ type: 'start', url: streamUrl() });
 
-// A page whose animation frames come slower than the stream's 20 ms (a busy main thread)
-// handles about one message per animation frame: every frame in flight is then one animation
-// frame of lag, so it asks for one frame at a time; a page that keeps up allows four (room for
-// the network's round trip).
-let lastAnimate = 0;
-let animateGapMs = 16;
-connection.ackWindow = () => (animateGapMs > 40 ? 1 : 4);
+/** Draws the worker's newest state if it is newer than the one on screen. */
+function drawNewest() {
+  if (!state) return;
+  hud.onCounters(state.counters());
+  if (!state.update() || state.frame === drawnFrame || !viewer.applyFrame(state)) return;
+  drawnFrame = state.frame;
+  drawnTime = state.time;
+  framesDrawn += 1;
+  hud.onDrawn(state);
+  plot.push(state.time, state.energy);
+  controls.setPaused(state.paused);
+}
 
 function animate(now) {
-  animateGapMs = 0.8 * animateGapMs + 0.2 * Math.min(1000, now - (lastAnimate || now));
-  lastAnimate = now;
   requestAnimationFrame(animate);
-  if (bodies.frame !== null && bodies.frame !== drawnFrame && viewer.applyFrame(bodies)) {
-    drawnFrame = bodies.frame;
-    drawnTime = bodies.time;
-    framesDrawn += 1;
+  drawNewest();
+  if (state && !self.crossOriginIsolated && !pulling) {
+    pulling = true;
+    worker.postMessage({ type: 'pull' });
   }
   viewer.render();
-  hud.onRender(now, drawnTime, connection.bytesReceived);
+  hud.onRender(now, drawnTime);
   plot.draw(now);
 }
 
@@ -86,20 +96,19 @@ function animate(now) {
 window.tumble = Object.freeze({
   get simTime() { return hud.simTime; },
   get shownTime() { return drawnTime; },
-  get lag() { return hud.lag; },
+  get lag() { return hud.lagAt(performance.now()); },
   get bytesPerSecond() { return hud.bytesPerSecond; },
-  get bytesReceived() { return connection.bytesReceived; },
+  get bytesReceived() { return hud.bytesReceived; },
   get frames() { return hud.framesReceived; },
   get framesDrawn() { return framesDrawn; },
   get dropped() { return hud.dropped; },
-  get connected() { return connection.state === 'open'; },
-  get connectionState() { return connection.state; },
-  get connects() { return connection.connects; },
+  get connected() { return connectionState === 'open'; },
+  get connectionState() { return connectionState; },
+  get connects() { return connects; },
   get paused() { return hud.paused; },
   get scene() { return currentScene; },
   get bodies() { return viewer.bodyCount; },
   bodyScreenPosition: (i) => viewer.bodyScreenPosition(i),
 });
 
-connection.start();
 requestAnimationFrame(animate);
