@@ -9,9 +9,10 @@ namespace tumble::server {
 
 namespace net = boost::asio;
 
-Broadcaster::Broadcaster(net::io_context& ioc, SimLoop& sim, std::chrono::milliseconds interval,
-                         std::size_t max_viewers)
+Broadcaster::Broadcaster(net::io_context& ioc, SimLoop& sim, Metrics& metrics,
+                         std::chrono::milliseconds interval, std::size_t max_viewers)
     : sim_(sim),
+      metrics_(metrics),
       interval_(interval),
       max_viewers_(max_viewers),
       strand_(net::make_strand(ioc)),
@@ -77,8 +78,9 @@ void Broadcaster::do_tick() {
   timer_.async_wait([this](boost::system::error_code ec) { on_tick(ec); });
 }
 
-// Copy the frame once into a shared buffer; lock the weak references outside the mutex's
-// critical work and deliver to each (Beast chat-multi shared_state::send).
+// Quantise once, publish, then only tell each session (a post per viewer): each takes the
+// newest frame relative to what it last sent when its previous write is done, so encodings
+// are shared between viewers in step and a slow one never queues (FrameStore, WsSession).
 void Broadcaster::on_tick(boost::system::error_code ec) {
   if (ec || stopped_) {
     ticking_ = false;
@@ -86,17 +88,47 @@ void Broadcaster::on_tick(boost::system::error_code ec) {
   }
   const Clock::time_point now = Clock::now();
   const auto live = sessions();
-  if (live.empty()) {  // No viewer: no encoding and no timer until one joins.
+  if (live.empty()) {  // No viewer: no frame and no timer until one joins.
     ticking_ = false;
     return;
   }
-  const std::shared_ptr<const Snapshot> snap = sim_.latest();
-  auto frame = std::make_shared<const std::string>(
-      encode_frame(*snap, frame_number_++, frame_time(*snap, now)));
-  for (const auto& s : live) s->deliver(frame, snap->scene);
+  publish(now);
+  for (const auto& s : live) s->notify();
   next_ += interval_;
   while (next_ <= now) next_ += interval_;  // Late by more than a period: skip, don't burst.
   do_tick();
+}
+
+void Broadcaster::publish(Clock::time_point now) {
+  const double cpu0 = thread_cpu_seconds();
+  const std::shared_ptr<const Snapshot> snap = sim_.latest();
+  auto state = make_frame_state(*snap, frame_number_++, frame_time(*snap, now), previous_.get());
+  auto status = status_if_due(*snap, *state);
+  store_.publish(state, snap->scene, std::move(status));
+  previous_ = std::move(state);
+  metrics_.add_stream_cpu(thread_cpu_seconds() - cpu0);
+}
+
+std::shared_ptr<const nlohmann::json> Broadcaster::status_if_due(const Snapshot& snap,
+                                                                 const FrameState& state) {
+  const std::string key = std::to_string(snap.scene->generation) + (snap.paused ? "p" : "r") +
+                          std::string(to_string(snap.integrator));
+  if (key == status_key_ && state.number - status_frame_ < kStatusEvery) return nullptr;
+  status_key_ = key;
+  status_frame_ = state.number;
+  const std::size_t n = snap.bodies->size();
+  return std::make_shared<const nlohmann::json>(nlohmann::json{
+      {"type", "status"},
+      {"frame", state.number},
+      {"time", snap.time},
+      {"step", snap.step},
+      {"paused", snap.paused},
+      {"real_time_factor", snap.real_time_factor},
+      {"integrator", std::string(to_string(snap.integrator))},
+      {"bodies", n},
+      {"awake", snap.awake},
+      {"asleep", n - snap.awake - snap.frozen},
+      {"frozen", snap.frozen}});
 }
 
 }  // namespace tumble::server

@@ -8,6 +8,7 @@
 #include "metrics.hpp"
 #include "options.hpp"
 #include "sim_loop.hpp"
+#include "static_cache.hpp"
 
 namespace tumble::server {
 
@@ -20,6 +21,7 @@ struct ServerContext {
   Metrics& metrics;                  ///< Counters.
   ConnectionCount& connections;      ///< Open connections against --max-connections.
   ReadBudget& read_budget;           ///< Per-client budget of /api/state and /api/scene.
+  StaticCache& static_cache;         ///< ETags and gzip copies of static files.
   int web_root_fd = -1;              ///< The web root opened O_PATH (static files open beneath it).
 };
 

@@ -9,6 +9,7 @@
 #include <new>
 
 #include "log.hpp"
+#include "static_cache.hpp"
 #include "static_files.hpp"
 #include "ws_session.hpp"
 
@@ -258,26 +259,63 @@ void HttpSession::serve_file(const Request& req) {
                                             : "not found";
     return send(error_response(req, found.status, why, ""));
   }
+  send_file(req, std::move(file), found);
+}
+
+// Static files are revalidated on every use (no-cache) but cheaply: a current copy gets 304
+// and no body. Text files go gzip-compressed to clients that accept it (made once per file
+// version, StaticCache), with the variant's own ETag.
+void HttpSession::send_file(const Request& req, beast::file file, const StaticLookup& found) {
+  struct stat st {};
+  if (::fstat(file.native_handle(), &st) != 0) return send(error_response(req, 404, "not found", ""));
+  const std::string_view type = mime_type(found.file);
+  const bool gzip = compressible(type) &&
+                    accepts_gzip(req[http::field::accept_encoding]) &&
+                    static_cast<std::size_t>(st.st_size) <= StaticCache::kMaxFile;
+  const std::string identity_tag = file_etag(st);
+  const std::string gzip_tag = identity_tag.substr(0, identity_tag.size() - 1) + "-gz\"";
+  const std::string_view if_none_match = req[http::field::if_none_match];
+  const auto headers = [&](auto& res, const std::string& etag) {
+    res.set(http::field::content_type, type);
+    res.set(http::field::cache_control, "no-cache");
+    res.set(http::field::etag, etag);
+    // Cross-origin isolation: the page may then share memory with its stream worker.
+    res.set("Cross-Origin-Opener-Policy", "same-origin");
+    res.set("Cross-Origin-Embedder-Policy", "require-corp");
+    if (compressible(type)) res.set(http::field::vary, "Accept-Encoding");
+    res.keep_alive(req.keep_alive());
+  };
+  if (etag_matches(if_none_match, identity_tag) || etag_matches(if_none_match, gzip_tag)) {
+    http::response<http::empty_body> res{http::status::not_modified, req.version()};
+    headers(res, gzip ? gzip_tag : identity_tag);
+    return send(std::move(res));
+  }
+  std::shared_ptr<const std::string> packed;
+  if (gzip) packed = ctx_.static_cache.gzip(found.relative.string(), file.native_handle(), st);
+  const std::uint64_t size = packed ? packed->size() : static_cast<std::uint64_t>(st.st_size);
+  if (req.method() == http::verb::head) {
+    http::response<http::empty_body> res{http::status::ok, req.version()};
+    headers(res, packed ? gzip_tag : identity_tag);
+    if (packed) res.set(http::field::content_encoding, "gzip");
+    res.content_length(size);
+    return send(std::move(res));
+  }
+  if (packed) {
+    http::response<http::string_body> res{http::status::ok, req.version()};
+    headers(res, gzip_tag);
+    res.set(http::field::content_encoding, "gzip");
+    res.body() = *packed;
+    res.content_length(size);
+    return send(std::move(res));
+  }
   beast::error_code ec;
   http::file_body::value_type body;
   body.reset(std::move(file), ec);
   if (ec) return send(error_response(req, 404, "not found", ""));
-  const std::uint64_t size = body.size();
-  const std::string_view type = mime_type(found.file);
-  if (req.method() == http::verb::head) {
-    http::response<http::empty_body> res{http::status::ok, req.version()};
-    res.set(http::field::content_type, type);
-    res.set(http::field::cache_control, "no-cache");
-    res.content_length(size);
-    res.keep_alive(req.keep_alive());
-    return send(std::move(res));
-  }
   http::response<http::file_body> res{std::piecewise_construct, std::make_tuple(std::move(body)),
                                       std::make_tuple(http::status::ok, req.version())};
-  res.set(http::field::content_type, type);
-  res.set(http::field::cache_control, "no-cache");
+  headers(res, identity_tag);
   res.content_length(size);
-  res.keep_alive(req.keep_alive());
   send(std::move(res));
 }
 

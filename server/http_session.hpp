@@ -16,6 +16,7 @@
 #include "context.hpp"
 #include "request_limits.hpp"
 #include "rest_api.hpp"
+#include "static_files.hpp"
 
 namespace tumble::server {
 
@@ -49,6 +50,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   void handle(Request&& request);
   void upgrade(Request&& request);
   void serve_file(const Request& request);
+  void send_file(const Request& request, boost::beast::file file, const StaticLookup& found);
   void reply_later(bool head, Response response);
   template <class Body>
   void send(boost::beast::http::response<Body>&& response);

@@ -1,5 +1,7 @@
 #include "metrics.hpp"
 
+#include <time.h>
+
 #include <sstream>
 
 #include "snapshot.hpp"
@@ -25,6 +27,12 @@ void counter(std::ostream& out, const char* name, const char* help, double value
 
 }  // namespace
 
+double thread_cpu_seconds() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 void Metrics::observe_step(double seconds) {
   std::size_t i = 0;
   while (i < kStepBuckets.size() && seconds > kStepBuckets[i]) ++i;
@@ -34,6 +42,8 @@ void Metrics::observe_step(double seconds) {
 }
 
 void Metrics::add_dropped_time(double seconds) { add(dropped_time_, seconds); }
+
+void Metrics::add_stream_cpu(double seconds) { add(stream_cpu_, seconds); }
 
 void Metrics::count_http(unsigned status) {
   const unsigned c = status / 100;
@@ -71,6 +81,12 @@ std::string Metrics::render(const Snapshot& s, std::size_t viewers) const {
   counter(out, "tumble_frames_dropped_total",
           "Frames replaced by a newer one before a slow viewer took them.",
           static_cast<double>(frames_dropped()));
+  counter(out, "tumble_frame_bytes_total", "Frame payload bytes written to viewers.",
+          static_cast<double>(frame_bytes()));
+  gauge(out, "tumble_frames_in_flight", "Frames being written now (at most one per viewer).",
+        static_cast<double>(frames_in_flight()));
+  counter(out, "tumble_stream_cpu_seconds_total",
+          "Thread CPU time spent making and encoding frames.", stream_cpu());
   counter(out, "tumble_dropped_sim_seconds_total",
           "Simulated time skipped because stepping fell behind real time.",
           dropped_time_.load(std::memory_order_relaxed));

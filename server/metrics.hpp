@@ -10,6 +10,9 @@ namespace tumble::server {
 
 struct Snapshot;
 
+/// CPU time of the calling thread, s (CLOCK_THREAD_CPUTIME_ID).
+double thread_cpu_seconds();
+
 /// Server-wide metrics.
 class Metrics {
  public:
@@ -29,6 +32,18 @@ class Metrics {
   std::uint64_t frames_sent() const { return frames_sent_.load(std::memory_order_relaxed); }
   /// Frames dropped so far (all sessions).
   std::uint64_t frames_dropped() const { return frames_dropped_.load(std::memory_order_relaxed); }
+  /// Adds `bytes` of frames written to viewers (WebSocket payload, before any compression).
+  void add_frame_bytes(std::size_t bytes) { frame_bytes_.fetch_add(bytes, std::memory_order_relaxed); }
+  /// Frame payload bytes so far (all sessions).
+  std::uint64_t frame_bytes() const { return frame_bytes_.load(std::memory_order_relaxed); }
+  /// A session started (+1) or finished (−1) writing a frame.
+  void add_frames_in_flight(int n) { frames_in_flight_.fetch_add(n, std::memory_order_relaxed); }
+  /// Frames being written now, all sessions (each holds at most one).
+  std::int64_t frames_in_flight() const { return frames_in_flight_.load(std::memory_order_relaxed); }
+  /// Adds thread CPU time spent making and encoding frames (broadcaster and encoders), s.
+  void add_stream_cpu(double seconds);
+  /// Stream CPU seconds so far.
+  double stream_cpu() const { return stream_cpu_.load(std::memory_order_relaxed); }
   /// A step or command failed to allocate memory (simulation thread).
   void count_step_failure() { step_failures_.fetch_add(1, std::memory_order_relaxed); }
   /// Allocation failures so far.
@@ -47,6 +62,9 @@ class Metrics {
   std::atomic<std::uint64_t> frames_sent_{0};
   std::atomic<std::uint64_t> frames_dropped_{0};
   std::atomic<std::uint64_t> step_failures_{0};
+  std::atomic<std::uint64_t> frame_bytes_{0};
+  std::atomic<std::int64_t> frames_in_flight_{0};
+  std::atomic<double> stream_cpu_{0.0};
   std::array<std::atomic<std::uint64_t>, 6> http_by_class_{};  // 0xx..5xx
 };
 

@@ -41,10 +41,10 @@ Server::Server(ServerOptions options, Scene scene)
       sim_(std::move(scene), metrics_, std::chrono::milliseconds(options_.step_budget_ms),
            static_cast<unsigned>(options_.sim_threads)),
       ioc_(options_.threads),
-      broadcaster_(ioc_, sim_, std::chrono::milliseconds(options_.render_ms),
+      broadcaster_(ioc_, sim_, metrics_, std::chrono::milliseconds(options_.render_ms),
                    static_cast<std::size_t>(options_.max_viewers)),
       ctx_{options_,  canonical_root(options_.web_root), sim_, broadcaster_, metrics_,
-           connections_, read_budget_} {
+           connections_, read_budget_, static_cache_} {
   ctx_.web_root_fd = web_root_fd_ = open_root(ctx_.web_root);
 }
 

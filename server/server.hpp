@@ -53,6 +53,8 @@ class Server {
   const Metrics& metrics() const { return metrics_; }
   /// Connected viewers.
   std::size_t viewers() const { return broadcaster_.viewers(); }
+  /// The broadcaster (its frame store, for tests).
+  Broadcaster& broadcaster() { return broadcaster_; }
   /// Open connections (HTTP and WebSocket).
   std::size_t connections() const { return connections_.open(); }
   /// The I/O context (for tests that post work to the I/O threads).
@@ -67,6 +69,7 @@ class Server {
   Metrics metrics_;
   ConnectionCount connections_;
   ReadBudget read_budget_;
+  StaticCache static_cache_;
   int web_root_fd_ = -1;
   SimLoop sim_;
   boost::asio::io_context ioc_;

@@ -48,6 +48,17 @@ bool inside(const std::filesystem::path& root, const std::filesystem::path& p) {
   return true;
 }
 
+// What index.html loads from node_modules: its import map (three, its addons' OrbitControls,
+// lil-gui, uplot), three.module.js's own import, and uPlot's stylesheet.
+constexpr std::array<std::string_view, 6> kServedModuleFiles{
+    "node_modules/three/build/three.module.js",
+    "node_modules/three/build/three.core.js",
+    "node_modules/three/examples/jsm/controls/OrbitControls.js",
+    "node_modules/lil-gui/dist/lil-gui.esm.js",
+    "node_modules/uplot/dist/uPlot.esm.js",
+    "node_modules/uplot/dist/uPlot.min.css",
+};
+
 }  // namespace
 
 StaticLookup resolve_static(const std::filesystem::path& root, std::string_view target) {
@@ -62,30 +73,23 @@ StaticLookup resolve_static(const std::filesystem::path& root, std::string_view 
   if (path.back() == '/') path += "index.html";
 
   // Every segment must be a plain name: no "..", ".", or empty segments ("//").
-  // The viewer's runtime modules (its import map: three, lil-gui, uplot) are served from
-  // /node_modules/; the rest of web/node_modules (build and test tooling, playwright-core
-  // among it: 38 MB) never is, nor are dotfiles (.git, .env …).
-  constexpr std::array<std::string_view, 3> kServedModules{"three", "lil-gui", "uplot"};
   fs::path relative;
   std::size_t start = 1;
-  bool in_node_modules = false;
-  for (int index = 0; start <= path.size(); ++index) {
+  for (; start <= path.size();) {
     const std::size_t end = std::min(path.find('/', start), path.size());
     const std::string_view segment(path.data() + start, end - start);
     if (segment.empty() || segment.front() == '.') return {403, {}};
-    if (segment == "node_modules") {
-      if (index != 0) return {403, {}};
-      in_node_modules = true;
-    } else if (in_node_modules) {
-      if (std::find(kServedModules.begin(), kServedModules.end(), segment) ==
-          kServedModules.end())
-        return {403, {}};
-      in_node_modules = false;
-    }
+    if (segment == "node_modules" && !relative.empty()) return {403, {}};  // Only at the top.
     relative /= fs::path(std::string(segment));
     start = end + 1;
   }
-  if (in_node_modules) return {403, {}};
+  // Of web/node_modules only the files the page imports (its import map and their own
+  // imports) are served; the rest (other builds of the same packages, build and test
+  // tooling, playwright-core among it: 38 MB) never is, nor are dotfiles (.git, .env …).
+  if (*relative.begin() == "node_modules" &&
+      std::find(kServedModuleFiles.begin(), kServedModuleFiles.end(),
+                std::string_view(path).substr(1)) == kServedModuleFiles.end())
+    return {403, {}};
 
   std::error_code ec;
   const fs::path resolved = fs::canonical(root / relative, ec);  // Follows symlinks.

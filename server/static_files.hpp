@@ -23,7 +23,7 @@ struct OpenedFile {
 /// "/" and "…/" mean index.html. Refuses, after percent-decoding: "..", "." and empty
 /// segments other than a trailing "/", backslashes, NUL, and any path (symlinks resolved)
 /// that does not stay inside `root`, dotfiles (any segment starting with '.') and anything
-/// under a node_modules directory (403). Directories are never listed (404).
+/// under node_modules but the files the page imports (403). Directories are never listed (404).
 StaticLookup resolve_static(const std::filesystem::path& root, std::string_view target);
 
 /// Opens `relative` (resolve_static's canonical path, so without symlinks when it was checked)

@@ -3,7 +3,10 @@
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
 
+#include <algorithm>
 #include <random>
+
+#include <nlohmann/json.hpp>
 
 #include "broadcaster.hpp"
 #include "log.hpp"
@@ -45,6 +48,18 @@ void WsSession::run(beast::http::request<beast::http::string_body> request) {
     res.set(beast::http::field::server, "tumble-server");
   }));
   ws_.read_message_max(kMaxClientMessage);
+  // permessage-deflate when the client offers it; used for text messages and keyframes only
+  // (WsSession::write_frame): deltas are compressed per viewer, which costs more CPU than
+  // the bytes it saves (docs/benchmarks.md).
+  websocket::permessage_deflate deflate;
+  deflate.server_enable = true;
+  deflate.server_max_window_bits = 12;
+  deflate.memLevel = 4;
+  deflate.compLevel = 6;
+  ws_.set_option(deflate);
+  // One WebSocket frame per message: a 25 kB frame in Beast's default 4 kB fragments costs
+  // seven writes per viewer instead of one.
+  ws_.auto_fragment(false);
   ws_.async_accept(request, beast::bind_front_handler(&WsSession::on_accept, shared_from_this()));
 }
 
@@ -65,6 +80,7 @@ void WsSession::on_accept(beast::error_code ec) {
   const std::shared_ptr<const SceneInfo> scene = broadcaster_.current_scene();
   generation_ = scene->generation;
   pending_scene_ = scene->message;
+  frame_waiting_ = true;  // The newest frame, if any, right after the scene message.
   do_write();
   do_read();
   do_ping_timer();
@@ -111,57 +127,114 @@ void WsSession::on_read(beast::error_code ec, std::size_t) {
     fail(ec, "websocket read");
     return finish();
   }
-  read_buffer_.consume(read_buffer_.size());  // Client messages are ignored.
+  if (ws_.got_text()) on_client_message();
+  read_buffer_.consume(read_buffer_.size());
   do_read();
 }
 
-void WsSession::deliver(std::shared_ptr<const std::string> frame,
-                        std::shared_ptr<const SceneInfo> scene) {
-  net::post(ws_.get_executor(),
-            beast::bind_front_handler(&WsSession::on_deliver, shared_from_this(),
-                                      std::move(frame), std::move(scene)));
-}
-
-void WsSession::on_deliver(std::shared_ptr<const std::string> frame,
-                           std::shared_ptr<const SceneInfo> scene) {
-  if (!accepted_ || closing_ || finished_) return;
-  if (scene->generation < generation_) return;  // A frame of a scene already replaced.
-  if (scene->generation > generation_) {
-    generation_ = scene->generation;
-    pending_scene_ = scene->message;
-    if (pending_frame_) metrics_.count_frame_dropped();
-    pending_frame_.reset();
-  }
-  if (pending_frame_) metrics_.count_frame_dropped();  // Newest wins.
-  pending_frame_ = std::move(frame);
+// The one client message understood: {"type": "ack", "frame": n}. Anything else is ignored.
+void WsSession::on_client_message() {
+  const auto data = read_buffer_.cdata();
+  const nlohmann::json j = nlohmann::json::parse(
+      static_cast<const char*>(data.data()), static_cast<const char*>(data.data()) + data.size(),
+      nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object() || j.value("type", "") != "ack" || !j.contains("frame") ||
+      !j["frame"].is_number_unsigned())
+    return;
+  const auto frame = j["frame"].get<std::uint64_t>();
+  if (j.contains("window") && j["window"].is_number_unsigned())
+    ack_window_ = std::clamp<std::size_t>(j["window"].get<std::size_t>(), 1, kAckWindow);
+  acking_ = true;
+  while (!unacked_.empty() && unacked_.front() <= frame) unacked_.pop_front();
   if (!writing_) do_write();
 }
 
-void WsSession::do_write() {
-  bool is_frame = false;
-  if (pending_scene_) {
-    in_flight_ = std::exchange(pending_scene_, nullptr);
-    ws_.text(true);
-  } else if (pending_frame_) {
-    in_flight_ = std::exchange(pending_frame_, nullptr);
-    ws_.binary(true);
-    is_frame = true;
-  } else {
-    return;
+void WsSession::notify() {
+  net::post(ws_.get_executor(),
+            beast::bind_front_handler(&WsSession::on_notify, shared_from_this()));
+}
+
+void WsSession::on_notify() {
+  if (!accepted_ || closing_ || finished_) return;
+  if (busy() && frame_waiting_ && base_) {  // The frame announced before is never sent.
+    ++dropped_;
+    metrics_.count_frame_dropped();
   }
+  frame_waiting_ = true;
+  if (!writing_) do_write();
+}
+
+bool WsSession::busy() const {
+  return writing_ || (acking_ && unacked_.size() >= ack_window_);
+}
+
+// Order: the first scene message, a newer scene's message (it resets the delta base), a new
+// status, then the newest frame. One write at a time; on_write comes back here.
+void WsSession::do_write() {
+  if (writing_ || closing_ || finished_) return;
+  if (pending_scene_) return write_text(std::exchange(pending_scene_, nullptr));
+  const Published pub = broadcaster_.store().newest();
+  if (!pub.state || pub.state->generation < generation_) return;
+  if (pub.state->generation > generation_) {
+    generation_ = pub.state->generation;
+    base_.reset();
+    return write_text(pub.scene->message);
+  }
+  if (pub.status && pub.status_sequence != status_sent_) {
+    status_sent_ = pub.status_sequence;
+    nlohmann::json status = *pub.status;
+    status["dropped"] = dropped_;
+    return write_text(std::make_shared<const std::string>(status.dump()));
+  }
+  if (frame_waiting_ && !busy() && write_frame(pub.state)) return;
+}
+
+// Sends `state` against base_ unless it would tell the viewer nothing new: nothing changed
+// since base_ (same flags, no body changed after it) and the last frame is recent.
+bool WsSession::write_frame(const std::shared_ptr<const FrameState>& state) {
+  frame_waiting_ = false;
+  const auto now = std::chrono::steady_clock::now();
+  if (base_) {
+    if (base_->number == state->number) return false;
+    const bool unchanged = state->last_change <= base_->number && state->flags == base_->flags;
+    if (unchanged && now - last_frame_at_ < std::chrono::milliseconds(kHeartbeatMs)) return false;
+  }
+  const double cpu0 = thread_cpu_seconds();
+  in_flight_ = broadcaster_.store().encoded(state, base_.get());
+  metrics_.add_stream_cpu(thread_cpu_seconds() - cpu0);
+  ws_.compress(!base_);  // Keyframes only: see docs/benchmarks.md, "permessage-deflate".
+  base_ = state;
+  last_frame_at_ = now;
+  if (acking_) unacked_.push_back(state->number);
   writing_ = true;
+  metrics_.add_frames_in_flight(1);
+  ws_.binary(true);
   ws_.async_write(net::buffer(*in_flight_),
-                  beast::bind_front_handler(&WsSession::on_write, shared_from_this(), is_frame));
+                  beast::bind_front_handler(&WsSession::on_write, shared_from_this(), true));
+  return true;
+}
+
+void WsSession::write_text(std::shared_ptr<const std::string> text) {
+  in_flight_ = std::move(text);
+  writing_ = true;
+  ws_.compress(true);
+  ws_.text(true);
+  ws_.async_write(net::buffer(*in_flight_),
+                  beast::bind_front_handler(&WsSession::on_write, shared_from_this(), false));
 }
 
 void WsSession::on_write(bool is_frame, beast::error_code ec, std::size_t) {
   writing_ = false;
+  if (is_frame) {
+    metrics_.add_frames_in_flight(-1);
+    metrics_.count_frame_sent();
+    metrics_.add_frame_bytes(in_flight_->size());
+  }
   in_flight_.reset();
   if (ec) {
     fail(ec, "websocket write");
     return finish();
   }
-  if (is_frame) metrics_.count_frame_sent();
   if (closing_) return do_close();
   do_write();
 }
@@ -184,8 +257,8 @@ void WsSession::finish() {
   if (finished_) return;
   finished_ = true;
   ping_timer_.cancel();
-  pending_frame_.reset();
   pending_scene_.reset();
+  base_.reset();
   broadcaster_.leave(this);
 }
 

@@ -1,12 +1,19 @@
 #pragma once
-/// One WebSocket viewer (/ws). All its work runs on its own strand. It sends the scene text
-/// message first (and again after each reset, before that scene's frames), then binary
-/// frames; at most one frame waits: a newer one replaces it and the drop is counted.
-/// Client messages are read and ignored (over 4 KiB: the connection is closed). Every half
+/// One WebSocket viewer (/ws), protocol version 2. All its work runs on its own strand. It
+/// sends the scene text message first (and again after each reset, before that scene's
+/// frames), status text messages, and binary frames pulled from the broadcaster's FrameStore:
+/// when its previous write is done it takes the newest frame, encoded against the frame it
+/// sent last (a keyframe when it has none of this scene). Nothing queues: a viewer that is
+/// slower than the frame rate gets fewer frames (each skipped one counts as dropped), never a
+/// stale one. A client that acknowledges frames (`{"type":"ack","frame":n,"window":w}`) is
+/// also held to w ≤ kAckWindow unacknowledged frames, so that a browser that reads its socket faster than it
+/// can process gets no queue either. Other client messages are ignored (over 4 KiB: the
+/// connection is closed). Every half
 /// viewer timeout it sends a ping with a random payload; a viewer that has not echoed it in a
 /// pong within the timeout (it does not read, or reads too slowly to reach the ping) is
 /// dropped, so its slot under --max-viewers is freed.
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 
@@ -16,6 +23,7 @@
 
 #include "admission.hpp"
 #include "metrics.hpp"
+#include "frame_state.hpp"
 #include "snapshot.hpp"
 
 namespace tumble::server {
@@ -27,6 +35,10 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
  public:
   /// Largest message a client may send, bytes.
   static constexpr std::size_t kMaxClientMessage = 4096;
+  /// Frames an acknowledging client may have unacknowledged (it may ask for fewer).
+  static constexpr std::size_t kAckWindow = 6;
+  /// A frame that changes nothing is still sent this often (it carries the sim time), ms.
+  static constexpr int kHeartbeatMs = 200;
 
   /// Takes over an accepted socket (its executor must be a strand); `timeout`: a ping left
   /// unanswered this long drops the viewer; `slot`: its place under --max-connections.
@@ -36,8 +48,8 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
 
   /// Completes the upgrade of `request` and starts sending.
   void run(boost::beast::http::request<boost::beast::http::string_body> request);
-  /// Queues `frame` (encoded once for everyone) of the scene `scene`. Thread-safe.
-  void deliver(std::shared_ptr<const std::string> frame, std::shared_ptr<const SceneInfo> scene);
+  /// Tells the session that the broadcaster published a newer frame. Thread-safe.
+  void notify();
   /// Closes with a close frame ("going away"). Thread-safe.
   void close();
 
@@ -45,9 +57,12 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void on_accept(boost::beast::error_code ec);
   void do_read();
   void on_read(boost::beast::error_code ec, std::size_t bytes);
-  void on_deliver(std::shared_ptr<const std::string> frame,
-                  std::shared_ptr<const SceneInfo> scene);
+  void on_notify();
+  void on_client_message();
+  bool busy() const;
   void do_write();
+  bool write_frame(const std::shared_ptr<const FrameState>& state);
+  void write_text(std::shared_ptr<const std::string> text);
   void on_write(bool is_frame, boost::beast::error_code ec, std::size_t bytes);
   void do_close();
   void finish();
@@ -66,9 +81,16 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   bool ping_outstanding_ = false;
   int ticks_unanswered_ = 0;
   std::shared_ptr<const std::string> pending_scene_;  // Text message to send first.
-  std::shared_ptr<const std::string> pending_frame_;  // The one waiting frame.
   std::shared_ptr<const std::string> in_flight_;      // Kept alive while being written.
-  std::uint64_t generation_ = 0;                      // Scene generation queued last.
+  std::shared_ptr<const FrameState> base_;            // The frame sent last (this scene).
+  std::uint64_t generation_ = 0;                      // Scene whose message was sent last.
+  std::uint64_t status_sent_ = 0;                     // Status sequence sent last.
+  std::uint64_t dropped_ = 0;                         // Frames this viewer never got.
+  std::chrono::steady_clock::time_point last_frame_at_{};
+  std::deque<std::uint32_t> unacked_;                 // Frames sent, not acknowledged.
+  bool acking_ = false;                               // The client acknowledges frames.
+  std::size_t ack_window_ = kAckWindow;               // Its window (its last ack's).
+  bool frame_waiting_ = false;                        // A newer frame exists, unsent.
   bool accepted_ = false;
   bool writing_ = false;
   bool closing_ = false;

@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 packages=(build-essential cmake ninja-build pkg-config git ca-certificates
   libboost1.81-dev libboost-program-options1.81-dev libeigen3-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev nodejs chromium gnuplot-nox
+  libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev nodejs chromium gnuplot-nox
   libbullet-dev libode-dev libmujoco-dev)
 missing=()
 for p in "${packages[@]}"; do

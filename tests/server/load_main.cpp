@@ -8,6 +8,9 @@
 ///       viewer slot; --viewer-timeout-ms 4000; a late viewer joins 8 s in and must be fed.
 /// full-hostile (issue 12): the full profile (scene seed) with hostile's 4 looping clients and
 ///       64 squatters added.
+/// stream (issue 13): 200 viewers + 1 stalled of scene pile while it lands (reset as the
+///       10 s window starts), 10 REST requests/s; adds the stream's CPU (broadcaster and
+///       encoders) and the frames in flight.
 /// Measures (over the loaded window, after a 2 s warm-up): the real-time factor (min of 1 s
 /// samples of /api/state), the fraction of broadcast frames each reader got (from the frame
 /// numbers), the server's resident memory growth, the mean step time before and under load,
@@ -67,6 +70,7 @@ constexpr Profile kHostile{20, 200, 20.0, 0.98, 0.95, 20.0, 5.0, 0.99, 64, 4};
 // 4 clients looping the most expensive GET and 64 squatting sockets"), on the full profile's
 // scene: 200 pile viewers would need ~1 GB/s of frames, beyond this 2-core machine.
 constexpr Profile kFullHostile{200, 1000, 20.0, 0.98, 0.95, 20.0, 5.0, 0.99, 64, 4};
+constexpr Profile kStream{200, 10, 10.0, 0.99, 0.99, 20.0, 5.0, 0.99};
 constexpr int kViewerTimeoutMs = 4000;  // hostile: squatters are dropped within 1.5 × this.
 constexpr int kRenderMs = 20;
 
@@ -250,12 +254,15 @@ int main(int argc, char** argv) {
     else return std::cerr << "unknown option " << a << "\n", 2;
   }
   if (profile_name != "full" && profile_name != "ci" && profile_name != "hostile" &&
-      profile_name != "full-hostile")
+      profile_name != "full-hostile" && profile_name != "stream")
     return std::cerr << "bad profile\n", 2;
   const Profile p = profile_name == "full"           ? kFull
                     : profile_name == "ci"           ? kCi
                     : profile_name == "full-hostile" ? kFullHostile
+                    : profile_name == "stream"       ? kStream
                                                      : kHostile;
+  const bool stream = profile_name == "stream";
+  if (stream && scene == "seed") scene = "pile";
   const bool hostile = p.squatters > 0;
   if (profile_name == "hostile" && scene == "seed") scene = "pile";
 
@@ -324,6 +331,10 @@ int main(int argc, char** argv) {
   const double rss_start = rss_mb(child.pid());
   m0 = http_get(port, "/metrics").body;
   const std::uint64_t dropped0 = static_cast<std::uint64_t>(metric(m0, "tumble_frames_dropped_total"));
+  if (stream) http_post(port, "/api/reset", R"({"scene": "pile"})");  // It lands in the window.
+  const double stream_cpu0 = metric(m0, "tumble_stream_cpu_seconds_total");
+  const double frame_bytes0 = metric(m0, "tumble_frame_bytes_total");
+  double in_flight_max = 0;
   counting = true;
   hogging = true;
   net::post(ioc, [&] {
@@ -361,6 +372,7 @@ int main(int argc, char** argv) {
       if (second == 1) viewers_at_1s = held;
       if (!squatters_gone_at && held <= p.viewers + (late_viewer ? 1 : 0)) squatters_gone_at = second;
     }
+    in_flight_max = std::max(in_flight_max, metric(mr.body, "tumble_frames_in_flight"));
     const double rtf = metric(mr.body, "tumble_real_time_factor");
     rtf_min = std::min(rtf_min, rtf);
     rtf_sum += rtf;
@@ -424,6 +436,8 @@ int main(int argc, char** argv) {
           : 0.0;
   const std::uint64_t dropped =
       static_cast<std::uint64_t>(metric(m1, "tumble_frames_dropped_total")) - dropped0;
+  const double stream_cpu = metric(m1, "tumble_stream_cpu_seconds_total") - stream_cpu0;
+  const double frame_bytes = metric(m1, "tumble_frame_bytes_total") - frame_bytes0;
   const int exit_code = child.stop();
 
   const double rss_growth = rss_max - rss_start;
@@ -470,6 +484,16 @@ int main(int argc, char** argv) {
       {"server exit code after SIGTERM", std::to_string(exit_code), "0", exit_code == 0},
   };
   std::vector<Row> hostile_rows;
+  if (stream) {
+    hostile_rows = {
+        {"stream CPU (broadcaster + encoders), share of a core", f(stream_cpu / p.seconds),
+         "<= 0.25", stream_cpu / p.seconds <= 0.25},
+        {"frame payload per reader, MB/s", f(frame_bytes / p.seconds / (p.viewers + 1) / 1e6),
+         "-", true},
+        {"frames in flight, max of 1 s samples (all sessions)", f(in_flight_max, 0),
+         "<= viewers + 1", in_flight_max <= p.viewers + 1},
+    };
+  }
   if (hostile) {
     hostile_rows = {
         {"health, slowest of 1 s samples, ms", f(health_max_ms, 1), "<= 50", health_max_ms <= 50},

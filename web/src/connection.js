@@ -7,14 +7,22 @@ const kMaxDelayMs = 5000;
 
 /**
  * A WebSocket to /ws that reconnects with exponential backoff (and a little jitter).
- * Callbacks: onScene(sceneMessage), onFrame(frame), onState(state, detail).
- * state is 'connecting' | 'open' | 'reconnecting'; detail.retryInMs is set when reconnecting.
+ * Callbacks: onScene(sceneMessage), onStatus(statusMessage), onFrame(frame, bytes) → false
+ * when the frame could not be applied (the connection is then reopened: a keyframe follows),
+ * onState(state, detail). state is 'connecting' | 'open' | 'reconnecting'; detail.retryInMs is
+ * set when reconnecting. Every frame handled is acknowledged to the server, which keeps at
+ * most a few unacknowledged frames in flight: a receiver too busy to handle its messages gets
+ * fewer frames instead of a growing queue (docs/protocol.md, "Pace"). The page runs it in a
+ * worker (stream_worker.js), whose event loop a busy page does not block.
  */
 export class StreamConnection {
-  constructor(url, { onScene, onFrame, onState, onError }) {
+  constructor(url, { onScene, onStatus, onFrame, onState, onError }) {
     this.url = url;
     this.onScene = onScene;
+    this.onStatus = onStatus;
     this.onFrame = onFrame;
+    this.bytesReceived = 0; // message payload bytes since the page loaded
+    this.ackWindow = () => 4; // frames the server may have in flight (docs/protocol.md, "ack")
     this.onState = onState;
     this.onError = onError ?? ((e) => console.warn(e));
     this.attempt = 0;
@@ -51,15 +59,22 @@ export class StreamConnection {
       this.#setState('open');
     };
     socket.onmessage = (event) => {
+      if (this.socket !== socket) return;
       try {
         if (typeof event.data === 'string') {
-          const scene = parseTextMessage(event.data);
-          if (scene) this.onScene(scene);
+          this.bytesReceived += event.data.length;
+          const message = parseTextMessage(event.data);
+          if (message?.type === 'scene') this.onScene(message);
+          else if (message?.type === 'status') this.onStatus(message);
         } else {
-          this.onFrame(decodeFrame(event.data));
+          this.bytesReceived += event.data.byteLength;
+          const frame = decodeFrame(event.data);
+          if (this.onFrame(frame) === false) throw new Error(`frame ${frame.frame} does not follow frame the page holds`);
+          socket.send(`{"type":"ack","frame":${frame.frame},"window":${this.ackWindow()}}`);
         }
       } catch (e) {
         this.onError(e);
+        socket.close(); // A fresh connection starts with a keyframe.
       }
     };
     socket.onclose = () => {
@@ -135,22 +150,3 @@ export const api = {
   /** impulse in N·s and point in metres, world frame. */
   impulse: (body, impulse, point) => request('POST', 'impulse', { body, impulse, point }),
 };
-
-/**
- * Polls GET /api/state every `everyMs` while `when()` is true, one request at a time; failures
- * are ignored (the stream's state already tells the user when the server is gone).
- */
-export function pollState({ everyMs, when, onState }) {
-  let busy = false;
-  return setInterval(async () => {
-    if (busy || !when()) return;
-    busy = true;
-    try {
-      onState(await api.state());
-    } catch {
-      // next tick tries again
-    } finally {
-      busy = false;
-    }
-  }, everyMs);
-}

@@ -1,6 +1,6 @@
-// Heads-up display: connection state, sim time, real-time factor, frame rates, dropped frames,
-// body activity counts, and short error toasts. Also keeps the statistics it shows.
-import { Activity } from './protocol.js';
+// Heads-up display: connection state, sim time, real-time factor, frame rates, bytes/s
+// received, lag behind the server, dropped frames, body activity counts, and short error
+// toasts. Also keeps the statistics it shows.
 
 /** Wall-clock window over which the drawing rate is measured, ms. */
 const kRateWindowMs = 1000;
@@ -29,14 +29,19 @@ export class Hud {
     this.integrator = '';
     this.simTime = 0;
     this.paused = false;
-    this.framesReceived = 0;   // binary frames received since the page loaded
-    this.dropped = 0;          // frames the server sent that never reached us (frame-number gaps)
-    this.lastFrameNumber = null;
+    this.framesReceived = 0;   // binary frames the stream worker received since it started
+    this.bytesReceived = 0;    // message payload bytes it received
+    this.dropped = 0;          // frames the server skipped for this page (its status message)
+    this.droppedBefore = 0;    // ... on earlier connections
+    this.latestAt = 0;         // wall clock (ms since the epoch) when simTime was received
+    this.shownTime = 0;        // sim time of the state drawn last, s
+    this.lag = 0;              // estimated server sim time minus shownTime, s
+    this.byteSamples = [];     // [wall ms, bytes received so far, frames received so far]
     this.counts = { awake: 0, asleep: 0, frozen: 0 };
-    this.frameSamples = [];    // [wall ms, sim time s] of recent frames
+    this.frameSamples = [];    // [wall ms, sim time s] of recently drawn states
     this.renderTimes = [];     // wall ms of recent animation frames
     this.lastRefresh = 0;
-    this.serverRtf = null;     // from GET /api/state
+    this.serverRtf = null;     // from the stream's status message
     this.serverRtfAt = 0;      // wall ms when it came
   }
 
@@ -45,7 +50,7 @@ export class Hud {
     this.retryInMs = detail.retryInMs ?? 0;
     if (state === 'open') {
       // A new connection may be a restarted server whose frame counter starts again.
-      this.lastFrameNumber = null;
+        this.droppedBefore = this.dropped;
       this.frameSamples.length = 0;
     }
     this.refresh(performance.now(), true);
@@ -61,32 +66,54 @@ export class Hud {
     this.integrator = name;
   }
 
-  /** Records a decoded frame received at wall time `now` (ms). */
-  onFrame(frame, now) {
-    this.framesReceived += 1;
-    if (this.lastFrameNumber !== null) {
-      const gap = (frame.frame - this.lastFrameNumber - 1) >>> 0; // u32 wrap-around safe
-      if (gap > 0 && gap < 1e6) this.dropped += gap;
-    }
-    this.lastFrameNumber = frame.frame;
-    if (frame.time < this.simTime) this.frameSamples.length = 0;
-    this.simTime = frame.time;
-    this.paused = frame.paused;
-    let asleep = 0, frozen = 0;
-    for (let i = 0; i < frame.count; i++) {
-      if (frame.activity[i] === Activity.asleep) asleep++;
-      else if (frame.activity[i] === Activity.frozen) frozen++;
-    }
-    this.counts = { awake: frame.count - asleep - frozen, asleep, frozen };
-    this.frameSamples.push([now, frame.time]);
+  /**
+   * Takes the stream worker's counters: bytes and frames received, and the newest server sim
+   * time it heard of (s) with the wall-clock time it came (ms since the epoch).
+   */
+  onCounters({ bytes, frames, serverTime, receivedAt }) {
+    this.bytesReceived = bytes;
+    this.framesReceived = frames;
+    this.simTime = serverTime;
+    this.latestAt = receivedAt;
+  }
+
+  /** Records a newly drawn state (a StateReader) at the current animation frame. */
+  onDrawn(state) {
+    const now = performance.now();
+    if (state.time < this.shownTime) this.frameSamples.length = 0;
+    this.paused = state.paused;
+    this.frameSamples.push([now, state.time]);
     trim(this.frameSamples, now, (s) => s[0], kFrameWindowMs);
   }
 
-  /** Records an animation frame at wall time `now` (ms) and refreshes the text now and then. */
-  onRender(now) {
+  /**
+   * Records an animation frame at wall time `now` (ms) that shows sim time `shownTime` (s);
+   * refreshes the text now and then.
+   */
+  onRender(now, shownTime) {
     this.renderTimes.push(now);
     trim(this.renderTimes, now, (t) => t, kRateWindowMs);
+    this.byteSamples.push([now, this.bytesReceived, this.framesReceived]);
+    trim(this.byteSamples, now, (s) => s[0], kFrameWindowMs);
+    this.shownTime = shownTime;
+    this.lag = this.lagAt(now);
     this.refresh(now, false);
+  }
+
+  /**
+   * Sim seconds the state on screen is behind the server at page time `now` (ms): the newest
+   * sim time the stream worker received, advanced by the wall time since (at the server's
+   * real-time factor), minus the sim time of the state drawn.
+   */
+  lagAt(now) {
+    const since = Math.max(0, performance.timeOrigin + now - this.latestAt) / 1000;
+    const serverTime = this.simTime + (this.paused ? 0 : since * (this.serverRtf ?? 1));
+    return Math.max(0, serverTime - this.shownTime);
+  }
+
+  /** Message bytes received per second over the last few seconds. */
+  get bytesPerSecond() {
+    return this.#sampleRate(1);
   }
 
   /** Frames per second drawn by the page. */
@@ -94,17 +121,19 @@ export class Hud {
     return rate(this.renderTimes.length, this.renderTimes[0], this.renderTimes[this.renderTimes.length - 1]);
   }
 
-  /** Frames per second received from the server over the last window (bursts do not inflate it). */
+  /** Frames per second received by the stream worker over the last few seconds. */
   get streamFps() {
-    const now = performance.now();
-    let n = 0;
-    for (const [wall] of this.frameSamples) if (now - wall <= kFrameWindowMs) n++;
-    const span = this.frameSamples.length ? Math.min(kFrameWindowMs, Math.max(kRateWindowMs, now - this.frameSamples[0][0])) : kFrameWindowMs;
-    return (n * 1000) / span;
+    return this.#sampleRate(2);
+  }
+
+  #sampleRate(column) {
+    const s = this.byteSamples;
+    if (s.length < 2 || s[s.length - 1][0] <= s[0][0]) return 0;
+    return ((s[s.length - 1][column] - s[0][column]) * 1000) / (s[s.length - 1][0] - s[0][0]);
   }
 
   /**
-   * Sim seconds per wall second: the server's own figure from GET /api/state when it is fresh,
+   * Sim seconds per wall second: the server's own figure from its status message when fresh,
    * else measured from the frames (0 while paused).
    */
   get realTimeFactor() {
@@ -116,8 +145,10 @@ export class Hud {
     return wall > 0 ? (s[s.length - 1][1] - s[0][1]) / wall : 0;
   }
 
-  /** Takes the server's view from GET /api/state (real-time factor, integrator). */
+  /** Takes the server's status message (real-time factor, integrator, counts, drops). */
   setServerState(state) {
+    if (Number.isFinite(state.awake)) this.counts = { awake: state.awake, asleep: state.asleep, frozen: state.frozen };
+    if (Number.isFinite(state.dropped)) this.dropped = this.droppedBefore + state.dropped;
     if (Number.isFinite(state.real_time_factor)) {
       this.serverRtf = state.real_time_factor;
       this.serverRtfAt = performance.now();
@@ -145,6 +176,8 @@ export class Hud {
     set(f.fps, `${this.renderFps.toFixed(0)}`);
     set(f.stream, live ? `${this.streamFps.toFixed(0)}` : '0');
     set(f.dropped, String(this.dropped));
+    set(f.bytes, live ? formatRate(this.bytesPerSecond) : '0 B/s');
+    set(f.lag, live ? `${(this.lag * 1000).toFixed(0)} ms` : '—');
     const c = this.counts;
     set(f.bodies, `${c.awake + c.asleep + c.frozen}`);
     set(f.activity, `${c.awake} awake · ${c.asleep} asleep${c.frozen ? ` · ${c.frozen} frozen` : ''}`);
@@ -159,6 +192,12 @@ export class Hud {
     this.toastBox.appendChild(el);
     setTimeout(() => el.remove(), 4000);
   }
+}
+
+function formatRate(bytesPerSecond) {
+  if (bytesPerSecond >= 1e6) return `${(bytesPerSecond / 1e6).toFixed(2)} MB/s`;
+  if (bytesPerSecond >= 1e3) return `${(bytesPerSecond / 1e3).toFixed(1)} kB/s`;
+  return `${bytesPerSecond.toFixed(0)} B/s`;
 }
 
 function set(elements, text) {

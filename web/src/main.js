@@ -1,6 +1,7 @@
 // Entry point: wires the stream to the viewer, HUD, energy plot and controls; runs the render loop.
 import { Viewer } from './viewer.js';
-import { StreamConnection, pollState, streamUrl } from './connection.js';
+import { streamUrl } from './connection.js';
+import { StateReader } from './shared_state.js';
 import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
@@ -21,70 +22,93 @@ function createViewer() {
 }
 
 let currentScene = null; // name of the scene the meshes were built for
-let latestFrame = null;  // newest frame not drawn yet (older ones are simply superseded)
+let state = null;        // StateReader of the worker's newest state for this scene
+let drawnFrame = null;   // number of the frame drawn last
+let drawnTime = 0;       // its sim time, s
 let framesDrawn = 0;
+let connectionState = 'connecting';
+let connects = 0;
+let pulling = false;     // a copy of the state was asked for (page not cross-origin isolated)
 
-const connection = new StreamConnection(streamUrl(), {
-  onScene(message) {
+// The stream lives in a worker: it applies every frame as it arrives, whatever this thread is
+// doing, and the animation loop below draws only the newest state (shared_state.js).
+const worker = new Worker(new URL('./stream_worker.js', import.meta.url), { type: 'module' });
+const handlers = {
+  scene({ message }) {
     const name = sceneName(message.scene);
     viewer.setScene(message, { refit: name !== currentScene });
     currentScene = name;
-    latestFrame = null;
+    state = null;
+    drawnFrame = null;
     plot.clear();
     hud.setScene(name, sceneIntegrator(message.scene));
     controls.setSceneName(name);
     controls.setIntegrator(sceneIntegrator(message.scene));
   },
-  onFrame(frame) {
-    hud.onFrame(frame, performance.now());
-    plot.push(frame.time, frame.energy);
-    controls.setPaused(frame.paused);
-    latestFrame = frame;
+  buffers({ buffers, update }) {
+    pulling = false;
+    if (update && state) state.attach(buffers);
+    else if (!update) state = new StateReader(buffers);
   },
-  onState(state, detail) {
-    hud.setConnection(state, detail);
-    if (state === 'open' && connection.connects > 1) controls.loadSceneList();
+  status({ message }) {
+    hud.setServerState(message);
+    if (message.integrator) controls.setIntegrator(message.integrator);
   },
-  onError(error) {
-    console.warn('tumble stream:', error);
+  connection({ state: s, detail, connects: n }) {
+    connectionState = s;
+    connects = n;
+    hud.setConnection(s, detail);
+    if (s === 'open' && n > 1) controls.loadSceneList();
   },
-});
+  error({ message }) {
+    console.warn('tumble stream:', message);
+  },
+};
+worker.onmessage = ({ data }) => handlers[data?.type]?.(data);
+worker.postMessage({ type: 'start', url: streamUrl() });
 
-// The server's real-time factor and integrator, twice a second. /api/state lists every body, so
-// large scenes skip it and the HUD measures the real-time factor from the frames instead.
-const kMaxPolledBodies = 2000;
-pollState({
-  everyMs: 500,
-  when: () => connection.state === 'open' && !document.hidden && viewer.bodyCount <= kMaxPolledBodies,
-  onState(state) {
-    hud.setServerState(state);
-    controls.setIntegrator(state.integrator);
-  },
-});
+/** Draws the worker's newest state if it is newer than the one on screen. */
+function drawNewest() {
+  if (!state) return;
+  hud.onCounters(state.counters());
+  if (!state.update() || state.frame === drawnFrame || !viewer.applyFrame(state)) return;
+  drawnFrame = state.frame;
+  drawnTime = state.time;
+  framesDrawn += 1;
+  hud.onDrawn(state);
+  plot.push(state.time, state.energy);
+  controls.setPaused(state.paused);
+}
 
 function animate(now) {
   requestAnimationFrame(animate);
-  if (latestFrame && viewer.applyFrame(latestFrame)) framesDrawn += 1;
-  latestFrame = null;
+  drawNewest();
+  if (state && !self.crossOriginIsolated && !pulling) {
+    pulling = true;
+    worker.postMessage({ type: 'pull' });
+  }
   viewer.render();
-  hud.onRender(now);
+  hud.onRender(now, drawnTime);
   plot.draw(now);
 }
 
 // A read-only window onto the page's state, for tests and the console.
 window.tumble = Object.freeze({
   get simTime() { return hud.simTime; },
+  get shownTime() { return drawnTime; },
+  get lag() { return hud.lagAt(performance.now()); },
+  get bytesPerSecond() { return hud.bytesPerSecond; },
+  get bytesReceived() { return hud.bytesReceived; },
   get frames() { return hud.framesReceived; },
   get framesDrawn() { return framesDrawn; },
   get dropped() { return hud.dropped; },
-  get connected() { return connection.state === 'open'; },
-  get connectionState() { return connection.state; },
-  get connects() { return connection.connects; },
+  get connected() { return connectionState === 'open'; },
+  get connectionState() { return connectionState; },
+  get connects() { return connects; },
   get paused() { return hud.paused; },
   get scene() { return currentScene; },
   get bodies() { return viewer.bodyCount; },
   bodyScreenPosition: (i) => viewer.bodyScreenPosition(i),
 });
 
-connection.start();
 requestAnimationFrame(animate);

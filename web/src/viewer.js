@@ -223,15 +223,20 @@ export class Viewer {
     for (let k = 0; k < 24; k++) edge.toArray(edgeColors, (i * 24 + k) * 3);
   }
 
-  /** Applies a decoded frame: vertex positions, flat normals, activity colours. */
+  /**
+   * Shows the newest poses of `frame` (a BodyStates): vertex positions, flat normals and
+   * activity colours of the bodies marked dirty, whose marks it clears.
+   */
   applyFrame(frame) {
     if (!this.boxes || frame.count !== this.bodyCount) return false;
-    const src = frame.vertices;
+    const src = frame.vertices, dirty = frame.dirty;
     const pos = this.boxes.geometry.attributes.position.array;
     const nrm = this.boxes.geometry.attributes.normal.array;
     const edgePos = this.edges.geometry.attributes.position.array;
     let colorsChanged = false;
     for (let i = 0; i < frame.count; i++) {
+      if (!dirty[i]) continue;
+      dirty[i] = 0;
       const b = i * 24;
       for (let f = 0; f < 6; f++) {
         const quad = this.faces[f];
