@@ -53,8 +53,18 @@ BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p) {
   return m;
 }
 
+/// Numbers the items with `has(k)` in order: slot[k] is their position, or −1; returns how many.
+template <typename Has>
+std::uint32_t number_slots(std::size_t n, std::vector<std::int32_t>& slot, Has&& has) {
+  slot.resize(n);
+  std::int32_t next = 0;
+  for (std::size_t k = 0; k < n; ++k) slot[k] = has(k) ? next++ : -1;
+  return static_cast<std::uint32_t>(next);
+}
+
 /// Box–box manifolds of the broad-phase pairs (each pair on its own, shared among the pool's
-/// threads), then in pair order the contacts, their links and the sleeping islands they wake.
+/// threads), their contacts written in pair order at positions numbered beforehand, then in
+/// pair order the sleeping islands they wake.
 void collide_pairs(StepContext& ctx) {
   constexpr std::size_t kGrain = 16;  // pairs per chunk: 0.2–1 µs each
   StepScratch& s = ctx.scratch;
@@ -62,15 +72,21 @@ void collide_pairs(StepContext& ctx) {
   ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) s.manifolds[k] = manifold_of(ctx, s.pairs[k]);
   });
-  s.box_contacts.clear();
-  s.links.clear();
+  const std::uint32_t count = number_slots(s.pairs.size(), s.slot,
+                                           [&](std::size_t k) { return s.manifolds[k].count > 0; });
+  s.box_contacts.resize(count);
+  s.links.resize(count);
+  ctx.pool.for_each(s.pairs.size(), 4 * kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      if (s.slot[k] < 0) continue;
+      const BodyPair& p = s.pairs[k];
+      s.box_contacts[s.slot[k]] =
+          contact_of(s.manifolds[k], p.first, p.second, ctx.bodies[p.first], ctx.bodies[p.second]);
+      s.links[s.slot[k]] = p;
+    }
+  });
   s.woken = 0;
-  for (std::size_t k = 0; k < s.pairs.size(); ++k) {
-    const BoxManifold& m = s.manifolds[k];
-    if (m.count == 0) continue;
-    const BodyPair& p = s.pairs[k];
-    s.box_contacts.push_back(contact_of(m, p.first, p.second, ctx.bodies[p.first], ctx.bodies[p.second]));
-    s.links.push_back(p);
+  for (const BodyPair& p : s.links) {
     for (const std::uint32_t id : {p.first, p.second}) {
       if (ctx.bodies[id].activity != Activity::asleep) continue;
       wake_island(ctx.cache, ctx.bodies, id);
@@ -87,31 +103,43 @@ void collide_pairs(StepContext& ctx) {
 // load and the floor in one consistent set of impulses. Floor contacts go first: Gauss–
 // Seidel then carries the support up the stack within one sweep. A body struck from above can
 // be driven down faster than it moves now: its floor margin also covers the speed of the
-// fastest body touching it.
+// fastest body touching it. Every linked body's floor contact is found on its own (shared
+// among the pool's threads), and those that reach the floor are copied, in ascending body
+// order, ahead of the box–box contacts.
 void collide_floor(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
-  s.contacts.clear();
-  if (!ctx.world.floor || s.box_contacts.empty()) return;
-  s.reach.resize(ctx.bodies.size());
-  for (std::uint32_t id : s.linked) s.reach[id] = 0.0;
-  for (const Contact& c : s.box_contacts) {
-    const Body &a = ctx.bodies[c.a], &b = ctx.bodies[c.b];
-    s.reach[c.a] = std::max(s.reach[c.a], point_speed_bound(b.s, b.c));
-    s.reach[c.b] = std::max(s.reach[c.b], point_speed_bound(a.s, a.c));
-  }
-  // Each linked body's floor contact on its own (shared among the pool's threads), then the
-  // bodies that reach no floor are dropped, keeping the ascending order.
-  s.contacts.resize(s.linked.size());
-  ctx.pool.for_each(s.linked.size(), 64, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::uint32_t id = s.linked[k];
-      const Body& b = ctx.bodies[id];
-      const double margin =
-          kSpeculativeDistance + ctx.dt * (point_speed_bound(b.s, b.c) + s.reach[id]);
-      floor_contact(b.s, b.c, id, ctx.world.floor->height, margin, s.contacts[k]);
+  std::uint32_t floor_count = 0;
+  if (ctx.world.floor && !s.box_contacts.empty()) {
+    s.reach.resize(ctx.bodies.size());
+    for (std::uint32_t id : s.linked) s.reach[id] = 0.0;
+    for (const Contact& c : s.box_contacts) {
+      const Body &a = ctx.bodies[c.a], &b = ctx.bodies[c.b];
+      s.reach[c.a] = std::max(s.reach[c.a], point_speed_bound(b.s, b.c));
+      s.reach[c.b] = std::max(s.reach[c.b], point_speed_bound(a.s, a.c));
     }
+    s.floor_slots.resize(s.linked.size());
+    ctx.pool.for_each(s.linked.size(), 64, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const std::uint32_t id = s.linked[k];
+        const Body& b = ctx.bodies[id];
+        const double margin =
+            kSpeculativeDistance + ctx.dt * (point_speed_bound(b.s, b.c) + s.reach[id]);
+        floor_contact(b.s, b.c, id, ctx.world.floor->height, margin, s.floor_slots[k]);
+      }
+    });
+    floor_count = number_slots(s.linked.size(), s.slot,
+                               [&](std::size_t k) { return s.floor_slots[k].count > 0; });
+  }
+  s.contacts.resize(floor_count + s.box_contacts.size());
+  ctx.pool.for_each(s.contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      if (i >= floor_count) s.contacts[i] = s.box_contacts[i - floor_count];
   });
-  std::erase_if(s.contacts, [](const Contact& c) { return c.count == 0; });
+  if (floor_count == 0) return;
+  ctx.pool.for_each(s.linked.size(), 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k)
+      if (s.slot[k] >= 0) s.contacts[s.slot[k]] = s.floor_slots[k];
+  });
 }
 
 }  // namespace
@@ -119,8 +147,7 @@ void collide_floor(StepContext& ctx) {
 void narrow_phase(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
   collide_pairs(ctx);
-  collide_floor(ctx);
-  s.contacts.insert(s.contacts.end(), s.box_contacts.begin(), s.box_contacts.end());
+  collide_floor(ctx);  // floor contacts, then the box–box ones
   ctx.stats.contacts = static_cast<std::uint32_t>(s.box_contacts.size());
   ctx.stats.contact_points = 0;
   for (const Contact& c : s.box_contacts) ctx.stats.contact_points += c.count;

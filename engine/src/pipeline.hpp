@@ -66,6 +66,8 @@ struct StepScratch {
   std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
   std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.
   std::vector<BoxManifold> manifolds;   ///< Manifold of each pair (count 0: no contact).
+  std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
+  std::vector<std::int32_t> slot;       ///< Position of each pair's (body's) contact, or −1.
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
   std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
