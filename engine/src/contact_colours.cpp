@@ -1,37 +1,36 @@
 #include "contact_colours.hpp"
 
 #include <algorithm>
-#include <bit>
 
 namespace tumble {
 
-// Greedy colouring in contact order (Box2D v3's constraint graph, Catto 2024 "Solver2D" and
-// "SIMD matters": colours are assigned as contacts begin; here they are recomputed each step,
-// which costs one pass over the contacts and keeps the result a function of the contact list
-// alone). A pile of boxes, about six neighbours each, needs about eight colours; the floor is
-// static and shared by every colour. Within a colour the contacts touch disjoint bodies, so
-// sweeping a colour in parallel gives bit for bit the sweep in order; the sweep order as a
-// whole (colour by colour) is the Gauss–Seidel order of the solve.
+// Colours that keep the sweep's order (the "waves" of a dependency graph): a contact's colour
+// is one more than the latest colour of the contacts before it that share one of its bodies,
+// so every body meets its contacts in the same order as in the sweep by contact index, and
+// the result is bit for bit that sweep's, on any number of threads. Measured alternative:
+// Box2D v3's greedy colouring (each contact takes the lowest colour free at both bodies, Catto
+// 2024) needs fewer colours but reorders the sweep, and the order changes from step to step as
+// contacts come and go: the 1,000-box `pile` then never settled (853 boxes awake after 20 s,
+// all asleep at 9.9 s in contact order). The floor is static and constrains nothing.
 void colour_contacts(std::span<const std::int32_t> a, std::span<const std::int32_t> b,
                      std::size_t body_count, ContactColours& out) {
   const std::size_t n = a.size();
-  out.used.assign(body_count, 0);
+  out.latest.assign(body_count, 0);
   out.colour.resize(n);
-  out.offset.assign(kMaxColours + 2, 0);
+  std::uint32_t colours = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t taken = (a[i] >= 0 ? out.used[a[i]] : 0) | (b[i] >= 0 ? out.used[b[i]] : 0);
-    const int c = std::min(std::countr_one(taken), kMaxColours);
-    if (c < kMaxColours) {
-      const std::uint64_t bit = std::uint64_t{1} << c;
-      if (a[i] >= 0) out.used[a[i]] |= bit;
-      if (b[i] >= 0) out.used[b[i]] |= bit;
-    }
-    out.colour[i] = static_cast<std::uint8_t>(c);
-    ++out.offset[c + 1];
+    const std::uint32_t c =
+        std::max(a[i] >= 0 ? out.latest[a[i]] : 0u, b[i] >= 0 ? out.latest[b[i]] : 0u);
+    if (a[i] >= 0) out.latest[a[i]] = c + 1;
+    if (b[i] >= 0) out.latest[b[i]] = c + 1;
+    out.colour[i] = c;
+    colours = std::max(colours, c + 1);
   }
+  // Counting sort by colour, stable: contact order within a colour.
+  out.offset.assign(colours + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) ++out.offset[out.colour[i] + 1];
   for (std::size_t k = 1; k < out.offset.size(); ++k) out.offset[k] += out.offset[k - 1];
   out.order.resize(n);
-  // The counts become fill positions; the fill runs in contact order (stable).
   std::vector<std::uint32_t>& next = out.offset;
   for (std::size_t i = 0; i < n; ++i) out.order[next[out.colour[i]]++] = static_cast<std::uint32_t>(i);
   // next[k] is now the end of colour k: shift back into starts.

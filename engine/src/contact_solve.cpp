@@ -43,6 +43,7 @@ void contact_solve(StepContext& ctx) {
     ctx.stats.impacts += static_cast<std::uint32_t>(
         solve_contacts(ctx.bodies, s.solver_bodies, s.contacts, ctx.world.gravity, ctx.dt,
                        SolverSettings{}, s.solver, ctx.pool));
+    ctx.stats.colours = static_cast<std::uint32_t>(s.solver.colours.count());
   }
   keep_for_warm_start(ctx);
 }

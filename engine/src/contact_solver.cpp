@@ -493,15 +493,14 @@ void warm_start_from(Contact& contact, const Contact& previous) {
 namespace {
 
 /// Runs fn(contact, index) over the contacts colour by colour, each colour shared among the
-/// pool's threads (its contacts touch disjoint bodies); the overflow colour runs in order.
+/// pool's threads (its contacts touch disjoint bodies).
 template <typename Fn>
 void sweep(const ContactColours& colours, std::span<Contact> contacts, WorkerPool& pool,
            Fn&& fn) {
   constexpr std::size_t kGrain = 32;  // contacts per chunk: 0.1–0.5 µs each
   for (std::size_t k = 0; k < colours.count(); ++k) {
     const std::span<const std::uint32_t> colour = colours.of(k);
-    const std::size_t grain = k == kMaxColours ? colour.size() : kGrain;
-    pool.for_each(colour.size(), grain, [&](std::size_t begin, std::size_t end) {
+    pool.for_each(colour.size(), kGrain, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) fn(contacts[colour[i]], colour[i]);
     });
   }
