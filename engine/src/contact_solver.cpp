@@ -319,6 +319,10 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
       order.emplace_back(std::min(height(contacts[i].a), height(contacts[i].b)),
                          static_cast<std::uint32_t>(i));
   std::sort(order.begin(), order.end());
+  if (pool.size() == 1) {  // the height order itself: what the waves replay
+    for (const auto& [h, i] : order) push_up(contacts[i], up, dt);
+    return;
+  }
   waves_.assign(sb_.size(), 0);
   wave_of_.resize(order.size());
   std::uint32_t last = 0;
@@ -498,6 +502,10 @@ template <typename Fn>
 void sweep(const ContactColours& colours, std::span<Contact> contacts, WorkerPool& pool,
            Fn&& fn) {
   constexpr std::size_t kGrain = 32;  // contacts per chunk: 0.1–0.5 µs each
+  if (pool.size() == 1) {  // contact order: what the colours replay, without their cost
+    for (std::size_t i = 0; i < contacts.size(); ++i) fn(contacts[i], i);
+    return;
+  }
   for (std::size_t k = 0; k < colours.count(); ++k) {
     const std::span<const std::uint32_t> colour = colours.of(k);
     pool.for_each(colour.size(), kGrain, [&](std::size_t begin, std::size_t end) {
@@ -512,19 +520,23 @@ void sweep(const ContactColours& colours, std::span<Contact> contacts, WorkerPoo
 // gravity, the collision pass (impacts with restitution), the contact pass (sequential
 // impulses, e = 0); positions then follow in flight with the corrected velocities
 // (semi-implicit Euler), the split-impulse pseudo velocities added to the positions only.
-// Every pass but shock propagation (ordered by height) sweeps the contacts colour by colour.
+// On several threads every pass but shock propagation (ordered by height, in waves) sweeps the
+// contacts colour by colour, which replays the sweep in contact order that one thread runs.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
                    const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool) {
   constexpr std::size_t kBodyGrain = 128;
   Solver solver(bodies, solver_bodies, scratch, pool, dt * gravity);
-  scratch.colour_a.resize(contacts.size());
-  scratch.colour_b.resize(contacts.size());
-  for (std::size_t i = 0; i < contacts.size(); ++i) {
-    scratch.colour_a[i] = contacts[i].a == kStaticBody ? -1 : scratch.index[contacts[i].a];
-    scratch.colour_b[i] = scratch.index[contacts[i].b];
+  scratch.colours.offset.clear();  // one thread: no colours, the sweeps go in contact order
+  if (pool.size() > 1) {
+    scratch.colour_a.resize(contacts.size());
+    scratch.colour_b.resize(contacts.size());
+    for (std::size_t i = 0; i < contacts.size(); ++i) {
+      scratch.colour_a[i] = contacts[i].a == kStaticBody ? -1 : scratch.index[contacts[i].a];
+      scratch.colour_b[i] = scratch.index[contacts[i].b];
+    }
+    colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), scratch.colours);
   }
-  colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), scratch.colours);
   if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
   pool.for_each(contacts.size(), 32, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) solver.prepare(contacts[i], i);
