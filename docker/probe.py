@@ -171,15 +171,25 @@ def check_websocket():
             break
         if time.monotonic() - t0 > TIMEOUT:
             fail("no binary frame within 5 s")
-    if len(data) < 32 or data[:4] != b"TMBL":
-        fail(f"binary frame has no TMBL header: {data[:32]!r}")
-    version, flags, frame, n = struct.unpack_from("<HHII", data, 4)
-    sim_time, energy = struct.unpack_from("<dd", data, 16)
-    if version != 1:
-        fail(f"binary frame format version {version}, expected 1")
-    if len(data) != 32 + 97 * n:
-        fail(f"binary frame is {len(data)} bytes, expected 32 + 97*{n} = {32 + 97 * n}")
-    ok(f"WebSocket binary frame: {len(data)} bytes, version {version}, frame {frame}, "
+    if len(data) < 40 or data[:4] != b"TMBL":
+        fail(f"binary frame has no TMBL header: {data[:40]!r}")
+    # docs/protocol.md, version 2: the first frame a viewer gets is a keyframe.
+    version, flags, frame, base, n, m = struct.unpack_from("<HHIIII", data, 4)
+    sim_time, energy = struct.unpack_from("<dd", data, 24)
+    if version != 2:
+        fail(f"binary frame format version {version}, expected 2")
+    if not flags & 4 or m != n or base != frame:
+        fail(f"first binary frame is not a keyframe (flags {flags}, base {base}, frame {frame}, "
+             f"{m} of {n} bodies)")
+    offset = 40
+    for _ in range(m):  # format byte, centre (i32 or i16 ×3), axes (i32 or i16 ×9)
+        if offset >= len(data):
+            fail(f"keyframe ends inside its records ({len(data)} bytes)")
+        fmt = data[offset]
+        offset += 1 + (12 if fmt & 4 else 6) + (36 if fmt & 8 else 18)
+    if offset != len(data):
+        fail(f"keyframe is {len(data)} bytes, its {m} records end at {offset}")
+    ok(f"WebSocket keyframe: {len(data)} bytes, version {version}, frame {frame}, "
        f"{n} bodies, t={sim_time:.3f} s, {1000 * (time.monotonic() - t0):.0f} ms after the scene")
     send_close(sock)
     sock.close()
