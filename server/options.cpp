@@ -7,7 +7,6 @@
 #include <cctype>
 #include <sstream>
 
-#include "tumble/world.hpp"
 
 namespace po = boost::program_options;
 
@@ -36,8 +35,9 @@ po::options_description describe() {
        "with --token: also require it on GETs (but /api/health) and on /ws")
       ("max-connections", po::value<int>()->default_value(512),
        "most open connections, HTTP and WebSocket (1-100000); beyond: 503")
-      ("sim-threads", po::value<int>()->default_value(static_cast<int>(World::hardware_threads())),
-       "threads of each physics step (1-256; default: one per core); results are the same for any count")
+      ("sim-threads", po::value<int>()->default_value(1),
+       "threads of each physics step (1-256); results are the same for any count. Default 1: "
+       "the cores also serve the viewers (docs/engine.md, Threads)")
       ("step-budget-ms", po::value<int>()->default_value(5000),
        "wall-time budget of one POST /api/step, ms (10-600000)")
       ("viewer-timeout-ms", po::value<int>()->default_value(15000),

@@ -5,8 +5,6 @@
 #include <cstdlib>
 #include <vector>
 
-#include "tumble/world.hpp"
-
 namespace tumble::server {
 namespace {
 
@@ -38,7 +36,7 @@ TEST(Options, Defaults) {
   EXPECT_EQ(p.options->step_budget_ms, 5000);
   EXPECT_EQ(p.options->viewer_timeout_ms, 15000);
   EXPECT_EQ(p.options->read_budget, 20000);
-  EXPECT_EQ(p.options->sim_threads, static_cast<int>(World::hardware_threads()));
+  EXPECT_EQ(p.options->sim_threads, 1);
 }
 
 // --sim-threads: the threads of each physics step, 1..256; also from TUMBLE_SIM_THREADS.
@@ -52,10 +50,10 @@ TEST(Options, SimThreads) {
     EXPECT_EQ(r.exit_code, 2) << bad;
     EXPECT_NE(r.message.find("sim-threads"), std::string::npos) << r.message;
   }
-  EnvVar env("TUMBLE_SIM_THREADS", "1");
+  EnvVar env("TUMBLE_SIM_THREADS", "2");
   const ParsedOptions e = parse({});
   ASSERT_TRUE(e.options) << e.message;
-  EXPECT_EQ(e.options->sim_threads, 1);
+  EXPECT_EQ(e.options->sim_threads, 2);
 }
 
 TEST(Options, HardeningLimits) {
