@@ -19,11 +19,12 @@ struct ServerFixture {
   Metrics metrics;
   SimLoop sim{tumble::load_scene("seed"), metrics};
   boost::asio::io_context ioc;
-  Broadcaster broadcaster{ioc, sim, std::chrono::milliseconds(20), 4};
+  Broadcaster broadcaster{ioc, sim, metrics, std::chrono::milliseconds(20), 4};
   ConnectionCount connections{64};
   ReadBudget read_budget{0, 0};
-  ServerContext ctx{options, std::filesystem::temp_directory_path(), sim, broadcaster, metrics,
-                    connections, read_budget};
+  StaticCache static_cache;
+  ServerContext ctx{options,     std::filesystem::temp_directory_path(), sim, broadcaster, metrics,
+                    connections, read_budget, static_cache};
   explicit ServerFixture(std::string token = "", std::string allowed_origin = "") {
     options.token = std::move(token);
     options.allowed_origin = std::move(allowed_origin);
