@@ -179,7 +179,9 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   }
   // The sweep's outer loop is shared among the pool's threads in fixed ranges, each with its
   // own list; joined in range order they are the pairs of the loop in order.
-  const std::size_t ranges = std::min<std::size_t>(4 * pool.size(), awake.size() / 64 + 1);
+  // One thread sweeps straight into `pairs`: no ranges to join.
+  const std::size_t ranges =
+      pool.size() == 1 ? 1 : std::min<std::size_t>(4 * pool.size(), awake.size() / 64 + 1);
   scratch.range_pairs.resize(ranges);
   pool.for_each(ranges, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
