@@ -386,21 +386,26 @@ test('pile: page weight, a slow page keeps up, bytes/s near zero asleep, a kicke
       try {
         await sleep(2000);
         // Steady state over 5 s: the server's sim time against the sim time on screen, and the
-        // HUD's own figure, sampled 20 times; the median must hold the bound.
-        const lags = [], hudLags = [];
+        // HUD's own figure, sampled 20 times; the median must hold the bound. The page answers
+        // an evaluate only between its 200 ms busy spells, so the server's clock is read before
+        // and after: the HUD's figure is for an instant between the two.
+        const lags = [], hudLags = [], lagsAfter = [];
         for (let i = 0; i < 20; i++) {
-          const server = await metric(base, 'tumble_sim_time_seconds');
+          const before = await metric(base, 'tumble_sim_time_seconds');
           const [shown, hudLag] = await page.evaluate(() => [window.tumble.shownTime, window.tumble.lag]);
-          lags.push(server - shown);
+          const after = await metric(base, 'tumble_sim_time_seconds');
+          lags.push(before - shown);
+          lagsAfter.push(after - shown);
           hudLags.push(hudLag);
           await sleep(250);
         }
-        const lag = median(lags), hudLag = median(hudLags);
-        t.diagnostic(`lag: median ${(lag * 1000).toFixed(0)} ms, worst ${(Math.max(...lags) * 1000).toFixed(0)} ms; ` +
-          `the HUD's median ${(hudLag * 1000).toFixed(0)} ms`);
+        const lag = median(lags), lagAfter = median(lagsAfter), hudLag = median(hudLags);
+        t.diagnostic(`lag: median ${(lag * 1000).toFixed(0)} ms (${(lagAfter * 1000).toFixed(0)} ms read after), ` +
+          `worst ${(Math.max(...lags) * 1000).toFixed(0)} ms; the HUD's median ${(hudLag * 1000).toFixed(0)} ms`);
         assert.ok(lag <= 0.5, `the slow page is ${lag.toFixed(2)} s behind (median of 20)`);
         // The HUD tells the lag it has: within 0.25 s of the lag measured against the server.
-        assert.ok(Math.abs(hudLag - lag) <= 0.25, `the HUD says ${hudLag.toFixed(2)} s, measured ${lag.toFixed(2)} s`);
+        assert.ok(hudLag >= lag - 0.25 && hudLag <= lagAfter + 0.25,
+          `the HUD says ${hudLag.toFixed(2)} s, measured ${lag.toFixed(2)}–${lagAfter.toFixed(2)} s`);
         assert.match(await hudText(page), /lag/);
         const asked = Date.now();
         assert.ok((await fetch(`${base}api/reset`, { method: 'POST', body: '{"scene": "many"}' })).ok);
