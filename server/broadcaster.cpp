@@ -19,7 +19,7 @@ Broadcaster::Broadcaster(net::io_context& ioc, SimLoop& sim, Metrics& metrics,
       timer_(strand_) {}
 
 void Broadcaster::start() {
-  net::post(strand_, [this] {
+  net::post(strand_, [this, owner = owner_.lock()] {
     started_ = true;
     wake();
   });
@@ -33,7 +33,7 @@ void Broadcaster::wake() {
 }
 
 void Broadcaster::stop() {
-  net::post(strand_, [this] {
+  net::post(strand_, [this, owner = owner_.lock()] {
     stopped_ = true;
     timer_.cancel();
   });
@@ -44,7 +44,7 @@ bool Broadcaster::join(const std::shared_ptr<WsSession>& session) {
   std::erase_if(sessions_, [](const auto& kv) { return kv.second.expired(); });
   if (sessions_.size() >= max_viewers_) return false;
   sessions_.emplace(session.get(), session);
-  net::post(strand_, [this] { wake(); });  // The timer sleeps while nobody watches.
+  net::post(strand_, [this, owner = owner_.lock()] { wake(); });  // The timer sleeps while nobody watches.
   return true;
 }
 
@@ -75,7 +75,8 @@ void Broadcaster::close_all() {
 
 void Broadcaster::do_tick() {
   timer_.expires_at(next_);
-  timer_.async_wait([this](boost::system::error_code ec) { on_tick(ec); });
+  timer_.async_wait(
+      [this, owner = owner_.lock()](boost::system::error_code ec) { on_tick(ec); });
 }
 
 // Quantise once, publish, then only tell each session (a post per viewer): each takes the

@@ -33,6 +33,10 @@ class Broadcaster {
   Broadcaster(boost::asio::io_context& ioc, SimLoop& sim, Metrics& metrics,
               std::chrono::milliseconds interval, std::size_t max_viewers);
 
+  /// Keeps `owner` (what holds this broadcaster) alive while a handler of this broadcaster is
+  /// pending, so that a removed world is freed only after its last timer handler ran. Set
+  /// before start().
+  void set_owner(std::weak_ptr<const void> owner) { owner_ = std::move(owner); }
   /// Starts the frame timer (absolute deadlines: start + k · interval). It runs only while a
   /// viewer is connected.
   void start();
@@ -64,6 +68,7 @@ class Broadcaster {
 
   SimLoop& sim_;
   Metrics& metrics_;
+  std::weak_ptr<const void> owner_;
   const std::chrono::milliseconds interval_;
   const std::size_t max_viewers_;
   boost::asio::strand<boost::asio::io_context::executor_type> strand_;

@@ -2,20 +2,24 @@
 
 namespace tumble::server {
 
-CommandResult command_error(unsigned status, std::string message, std::string field) {
-  return {status, {{"error", std::move(message)}, {"field", std::move(field)}}};
+CommandOutcome command_error(Failure failure, std::string message, std::string field) {
+  return CommandError{failure, std::move(message), std::move(field)};
 }
 
 void CommandQueue::push(Command command) {
+  bool queued = false;
   {
     std::lock_guard lock(mutex_);
     if (!closed_) {
       queue_.push_back(std::move(command));
-      cv_.notify_one();
-      return;
+      queued = true;
     }
   }
-  if (command.done) command.done(command_error(503, "the server is shutting down", ""));
+  if (queued) {
+    if (wake_) wake_();
+  } else if (command.done) {
+    command.done(command_error(Failure::unavailable, "the server is shutting down", ""));
+  }
 }
 
 std::deque<Command> CommandQueue::drain() {
@@ -23,20 +27,9 @@ std::deque<Command> CommandQueue::drain() {
   return std::exchange(queue_, {});
 }
 
-void CommandQueue::wait() {
-  std::unique_lock lock(mutex_);
-  cv_.wait(lock, [this] { return closed_ || !queue_.empty(); });
-}
-
-void CommandQueue::wait_until(std::chrono::steady_clock::time_point deadline) {
-  std::unique_lock lock(mutex_);
-  cv_.wait_until(lock, deadline, [this] { return closed_ || !queue_.empty(); });
-}
-
 void CommandQueue::close() {
   std::lock_guard lock(mutex_);
   closed_ = true;
-  cv_.notify_all();
 }
 
 bool CommandQueue::closed() const {

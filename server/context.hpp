@@ -4,11 +4,10 @@
 #include <filesystem>
 
 #include "admission.hpp"
-#include "broadcaster.hpp"
 #include "metrics.hpp"
 #include "options.hpp"
-#include "sim_loop.hpp"
 #include "static_cache.hpp"
+#include "worlds.hpp"
 
 namespace tumble::server {
 
@@ -16,8 +15,7 @@ namespace tumble::server {
 struct ServerContext {
   const ServerOptions& options;      ///< As parsed.
   std::filesystem::path web_root;    ///< Canonical absolute web root.
-  SimLoop& sim;                      ///< Commands go here; snapshots come from here.
-  Broadcaster& broadcaster;          ///< Viewers join here.
+  WorldRegistry& worlds;             ///< The worlds: commands, snapshots, viewers.
   Metrics& metrics;                  ///< Counters.
   ConnectionCount& connections;      ///< Open connections against --max-connections.
   ReadBudget& read_budget;           ///< Per-client budget of /api/state and /api/scene.

@@ -94,7 +94,7 @@ bool costly_read(const Request& req) {
   if (req.method() != http::verb::get && req.method() != http::verb::head) return false;
   const std::string_view target = req.target();
   const std::string_view path = target.substr(0, target.find_first_of("?#"));
-  return path == "/api/state" || path == "/api/scene";
+  return path.ends_with("/state") || path.ends_with("/scene");
 }
 
 }  // namespace
@@ -180,8 +180,10 @@ void HttpSession::handle(Request&& req) {
   if (beast::websocket::is_upgrade(req)) return upgrade(std::move(req));
   if (is_api_target(req.target())) {
     const bool head = req.method() == http::verb::head;
-    if (costly_read(req)) {
-      const double cost = 1.0 + static_cast<double>(ctx_.sim.latest()->bodies->size());
+    const std::shared_ptr<HostedWorld> world =
+        costly_read(req) ? world_of_target(req.target(), ctx_) : nullptr;
+    if (world) {
+      const double cost = 1.0 + static_cast<double>(world->sim().latest()->bodies->size());
       if (const int wait = ctx_.read_budget.admit(client_, cost)) {
         Response res = error_response(req, 429, "read budget of this client spent", "");
         res.set(http::field::retry_after, std::to_string(wait));
@@ -229,12 +231,18 @@ void HttpSession::upgrade(Request&& req) {
       !token_matches(form_decode(query_parameter(req.target(), "access_token")),
                      ctx_.options.token))
     return send(error_response(req, 401, "missing or wrong token", "Authorization"));
-  if (ctx_.broadcaster.viewers() >= static_cast<std::size_t>(ctx_.options.max_viewers))
+  const std::string id = form_decode(query_parameter(req.target(), "world"));
+  const std::shared_ptr<HostedWorld> world =
+      ctx_.worlds.find(id.empty() ? std::string(kDefaultWorld) : id);
+  if (!world)
+    return send(error_response(req, 404, "no world '" + quoted_prefix(id) + "'", "world"));
+  if (world->broadcaster().viewers() >= static_cast<std::size_t>(ctx_.options.max_viewers))
     return send(error_response(req, 503, "too many viewers", ""));
+  world->touch();
   stream_.expires_never();
-  std::make_shared<WsSession>(stream_.release_socket(), ctx_.broadcaster, ctx_.metrics,
+  std::make_shared<WsSession>(stream_.release_socket(), world->broadcaster(), ctx_.metrics,
                               std::chrono::milliseconds(ctx_.options.viewer_timeout_ms),
-                              std::move(slot_))
+                              std::move(slot_), world)
       ->run(std::move(req));
 }
 

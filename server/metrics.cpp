@@ -27,6 +27,30 @@ void counter(std::ostream& out, const char* name, const char* help, double value
 
 }  // namespace
 
+std::string render_world_gauges(const std::vector<WorldGauges>& worlds) {
+  std::ostringstream out;
+  out.precision(17);
+  gauge(out, "tumble_worlds", "Worlds on this server, the default counted.",
+        static_cast<double>(worlds.size()));
+  const auto family = [&](const char* name, const char* help, auto value) {
+    out << "# HELP " << name << ' ' << help << "\n# TYPE " << name << " gauge\n";
+    for (const WorldGauges& w : worlds)
+      out << name << "{world=\"" << w.id << "\"} " << static_cast<double>(value(w)) << '\n';
+  };
+  family("tumble_world_real_time_factor", "Simulated seconds per wall second, per world.",
+         [](const WorldGauges& w) { return w.real_time_factor; });
+  family("tumble_world_sim_time_seconds", "Simulated time since the last reset, per world.",
+         [](const WorldGauges& w) { return w.time; });
+  family("tumble_world_bodies", "Bodies, per world.", [](const WorldGauges& w) { return w.bodies; });
+  family("tumble_world_bodies_awake", "Bodies integrated each step, per world.",
+         [](const WorldGauges& w) { return w.awake; });
+  family("tumble_world_viewers", "Connected WebSocket viewers, per world.",
+         [](const WorldGauges& w) { return w.viewers; });
+  family("tumble_world_paused", "1 while the world is paused.",
+         [](const WorldGauges& w) { return w.paused ? 1 : 0; });
+  return out.str();
+}
+
 double thread_cpu_seconds() {
   timespec ts{};
   ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);

@@ -5,10 +5,25 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace tumble::server {
 
 struct Snapshot;
+
+/// One world's gauges for /metrics.
+struct WorldGauges {
+  std::string id;                ///< World id.
+  double real_time_factor = 0;   ///< Sim s per wall s (0 paused).
+  double time = 0;               ///< Sim time, s.
+  std::size_t bodies = 0;        ///< Bodies.
+  std::size_t awake = 0;         ///< Bodies awake.
+  std::size_t viewers = 0;       ///< WebSocket viewers.
+  bool paused = false;           ///< Paused.
+};
+
+/// The per-world gauges (label world="id") and tumble_worlds, Prometheus text.
+std::string render_world_gauges(const std::vector<WorldGauges>& worlds);
 
 /// CPU time of the calling thread, s (CLOCK_THREAD_CPUTIME_ID).
 double thread_cpu_seconds();

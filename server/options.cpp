@@ -35,9 +35,19 @@ po::options_description describe() {
        "with --token: also require it on GETs (but /api/health) and on /ws")
       ("max-connections", po::value<int>()->default_value(512),
        "most open connections, HTTP and WebSocket (1-100000); beyond: 503")
-      ("sim-threads", po::value<int>()->default_value(1),
-       "threads of each physics step (1-256); results are the same for any count. Default 1: "
-       "the cores also serve the viewers (docs/engine.md, Threads)")
+      ("sim-threads", po::value<int>()->default_value(0),
+       "simulation threads shared by all worlds (0: one per core, 1-256)")
+      ("step-threads", po::value<int>()->default_value(1),
+       "threads of each world's physics step (1-256); results are the same for any count. "
+       "Default 1: the cores also serve other worlds and the viewers (docs/engine.md, Threads)")
+      ("max-worlds", po::value<int>()->default_value(64),
+       "most worlds on this server, the default counted (1-10000); beyond: 429")
+      ("max-bodies", po::value<int>()->default_value(5000),
+       "most bodies in a scene sent by a client (PUT /api/worlds, reset; 1-100000)")
+      ("idle-s", po::value<double>()->default_value(300),
+       "pause a world (not the default) with no viewer and no request for this long, s")
+      ("idle-remove-s", po::value<double>()->default_value(3600),
+       "remove such a world after this long idle, s (at least --idle-s)")
       ("step-budget-ms", po::value<int>()->default_value(5000),
        "wall-time budget of one POST /api/step, ms (10-600000)")
       ("viewer-timeout-ms", po::value<int>()->default_value(15000),
@@ -112,7 +122,20 @@ ParsedOptions parse_options(int argc, const char* const argv[]) {
   if (o.max_connections < 1 || o.max_connections > 100000)
     return bad("--max-connections must be in 1..100000", d);
   o.sim_threads = vm["sim-threads"].as<int>();
-  if (o.sim_threads < 1 || o.sim_threads > 256) return bad("--sim-threads must be in 1..256", d);
+  if (o.sim_threads < 0 || o.sim_threads > 256) return bad("--sim-threads must be in 0..256", d);
+  o.step_threads = vm["step-threads"].as<int>();
+  if (o.step_threads < 1 || o.step_threads > 256)
+    return bad("--step-threads must be in 1..256", d);
+  o.max_worlds = vm["max-worlds"].as<int>();
+  if (o.max_worlds < 1 || o.max_worlds > 10000) return bad("--max-worlds must be in 1..10000", d);
+  o.max_bodies = vm["max-bodies"].as<int>();
+  if (o.max_bodies < 1 || o.max_bodies > 100000)
+    return bad("--max-bodies must be in 1..100000", d);
+  o.idle_s = vm["idle-s"].as<double>();
+  if (!(o.idle_s >= 0.1 && o.idle_s <= 1e7)) return bad("--idle-s must be in 0.1..1e7", d);
+  o.idle_remove_s = vm["idle-remove-s"].as<double>();
+  if (!(o.idle_remove_s >= o.idle_s && o.idle_remove_s <= 1e8))
+    return bad("--idle-remove-s must be at least --idle-s and at most 1e8", d);
   o.step_budget_ms = vm["step-budget-ms"].as<int>();
   if (o.step_budget_ms < 10 || o.step_budget_ms > 600000)
     return bad("--step-budget-ms must be in 10..600000", d);

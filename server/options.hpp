@@ -15,7 +15,8 @@ struct ServerOptions {
   int render_ms = 20;                  ///< Interval between WebSocket frames, ms.
   std::filesystem::path web_root;      ///< Directory of the viewer's static files.
   int threads = 2;                     ///< I/O threads (the simulation has its own).
-  int sim_threads = 1;                 ///< Threads of each physics step (World::set_threads).
+  int sim_threads = 0;                 ///< Simulation threads all worlds share (0: the cores).
+  int step_threads = 1;                ///< Threads of each physics step (World::set_threads).
   std::string token;                   ///< Bearer token for POSTs; empty: none required.
   int max_viewers = 64;                ///< Most WebSocket viewers at once.
   std::string allowed_origin;          ///< Origin allowed besides the server's own; "*": any.
@@ -24,6 +25,10 @@ struct ServerOptions {
   int step_budget_ms = 5000;           ///< Wall-time budget of one POST /api/step, ms.
   int viewer_timeout_ms = 15000;       ///< A viewer that answers no ping this long is dropped, ms.
   double read_budget = 20000;          ///< Body records/s per client for /api/state, /api/scene.
+  int max_worlds = 64;                 ///< Most worlds, the default counted (PUT beyond: 429).
+  int max_bodies = 5000;               ///< Most bodies in a scene sent over REST (beyond: 400).
+  double idle_s = 300;                 ///< A world with no viewer or request this long pauses, s.
+  double idle_remove_s = 3600;         ///< … and is removed after this long, s.
 };
 
 /// Result of parsing: options, or an exit code with the text to print.

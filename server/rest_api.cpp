@@ -6,6 +6,7 @@
 
 #include "request_limits.hpp"
 #include "tumble/scene_io.hpp"
+#include "worlds.hpp"
 
 namespace tumble::server {
 
@@ -21,12 +22,21 @@ struct Refusal {
   std::string field;
 };
 
-using Handler = void (*)(const Request&, ServerContext&, const Reply&);
+/// A route of one world: "/api/state" … (also under /api/worlds/{id}/…).
+using WorldHandler = void (*)(const Request&, ServerContext&, HostedWorld&, const Reply&);
+/// A route of the server: health, scenes, metrics, the worlds collection.
+using ServerHandler = void (*)(const Request&, ServerContext&, const Reply&);
 
-struct Route {
+struct WorldRoute {
   std::string_view path;
   http::verb method;
-  Handler handler;
+  WorldHandler handler;
+};
+
+struct ServerRoute {
+  std::string_view path;
+  http::verb method;
+  ServerHandler handler;
 };
 
 Response json_response(unsigned version, bool keep_alive, unsigned status, const json& body) {
@@ -102,15 +112,17 @@ constexpr double kMaxPoint = 1e6;
 
 // ---- Commands ------------------------------------------------------------------------
 
-void submit(ServerContext& ctx, const Request& req, CommandKind kind, const Reply& reply) {
+// The outcome becomes HTTP here, on whichever thread completes it (cheap: one JSON dump).
+void submit(HostedWorld& world, const Request& req, CommandKind kind, const Reply& reply) {
   const unsigned version = req.version();
   const bool keep_alive = req.keep_alive();
-  ctx.sim.submit({std::move(kind), [reply, version, keep_alive](CommandResult r) {
-                    reply(json_response(version, keep_alive, r.status, r.body));
-                  }});
+  world.sim().submit({std::move(kind), [reply, version, keep_alive](CommandOutcome r) {
+                        reply(json_response(version, keep_alive, outcome_status(r),
+                                            outcome_json(r)));
+                      }});
 }
 
-Scene scene_from_request(const json& scene) {
+Scene parse_scene(const json& scene) {
   const auto prefixed = [](const std::string& field) {
     return field.empty() ? std::string("scene") : "scene." + field;
   };
@@ -141,12 +153,23 @@ Scene scene_from_request(const json& scene) {
   }
 }
 
-void post_reset(const Request& req, ServerContext& ctx, const Reply& reply) {
+Scene scene_from_request(const json& scene, const ServerOptions& options) {
+  Scene parsed = parse_scene(scene);
+  if (parsed.bodies.size() > static_cast<std::size_t>(options.max_bodies))
+    throw Refusal{400,
+                  "the scene has " + std::to_string(parsed.bodies.size()) +
+                      " bodies; this server takes at most " + std::to_string(options.max_bodies) +
+                      " per world (--max-bodies)",
+                  "scene.bodies"};
+  return parsed;
+}
+
+void post_reset(const Request& req, ServerContext& ctx, HostedWorld& world, const Reply& reply) {
   const json body = parse_body(req);
   only_keys(body, {"scene"});
   ResetCommand c;
-  if (body.contains("scene")) c.scene = scene_from_request(body["scene"]);
-  submit(ctx, req, std::move(c), reply);
+  if (body.contains("scene")) c.scene = scene_from_request(body["scene"], ctx.options);
+  submit(world, req, std::move(c), reply);
 }
 
 // The protocol says these bodies are empty: anything else is a client that meant something.
@@ -154,17 +177,17 @@ void require_empty_body(const Request& req) {
   if (!req.body().empty()) throw Refusal{400, "this request takes no body", ""};
 }
 
-void post_pause(const Request& req, ServerContext& ctx, const Reply& reply) {
+void post_pause(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
   require_empty_body(req);
-  submit(ctx, req, PauseCommand{}, reply);
+  submit(world, req, PauseCommand{}, reply);
 }
 
-void post_resume(const Request& req, ServerContext& ctx, const Reply& reply) {
+void post_resume(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
   require_empty_body(req);
-  submit(ctx, req, ResumeCommand{}, reply);
+  submit(world, req, ResumeCommand{}, reply);
 }
 
-void post_step(const Request& req, ServerContext& ctx, const Reply& reply) {
+void post_step(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
   const json body = parse_body(req);
   only_keys(body, {"steps"});
   const json& steps = required(body, "steps");
@@ -172,10 +195,10 @@ void post_step(const Request& req, ServerContext& ctx, const Reply& reply) {
   const bool huge = steps.is_number_unsigned() && steps.get<std::uint64_t>() > 100000;
   const std::int64_t n = huge ? 0 : steps.get<std::int64_t>();
   if (n < 1 || n > 100000) throw Refusal{400, "steps must be in 1..100000", "steps"};
-  submit(ctx, req, StepCommand{static_cast<std::uint32_t>(n)}, reply);
+  submit(world, req, StepCommand{static_cast<std::uint32_t>(n)}, reply);
 }
 
-void post_impulse(const Request& req, ServerContext& ctx, const Reply& reply) {
+void post_impulse(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
   const json body = parse_body(req);
   only_keys(body, {"body", "impulse", "point"});
   ImpulseCommand c;
@@ -191,10 +214,11 @@ void post_impulse(const Request& req, ServerContext& ctx, const Reply& reply) {
   }
   c.impulse = finite_vec3(required(body, "impulse"), "impulse", kMaxImpulse);
   if (body.contains("point")) c.point = finite_vec3(body["point"], "point", kMaxPoint);
-  submit(ctx, req, std::move(c), reply);
+  submit(world, req, std::move(c), reply);
 }
 
-void post_integrator(const Request& req, ServerContext& ctx, const Reply& reply) {
+void post_integrator(const Request& req, ServerContext&, HostedWorld& world,
+                     const Reply& reply) {
   const json body = parse_body(req);
   only_keys(body, {"integrator"});
   const json& name = required(body, "integrator");
@@ -203,7 +227,7 @@ void post_integrator(const Request& req, ServerContext& ctx, const Reply& reply)
   if (!i)
     throw Refusal{400, "unknown integrator '" + quoted_prefix(name.get<std::string>()) + "'",
                   "integrator"};
-  submit(ctx, req, SetIntegratorCommand{*i}, reply);
+  submit(world, req, SetIntegratorCommand{*i}, reply);
 }
 
 // ---- Reads from the latest snapshot ----------------------------------------------------
@@ -212,39 +236,113 @@ void get_health(const Request& req, ServerContext&, const Reply& reply) {
   reply(ok(req, {{"status", "ok"}}));
 }
 
-void get_scene(const Request& req, ServerContext& ctx, const Reply& reply) {
-  reply(ok(req, scene_json(*ctx.sim.latest())));
+void get_scene(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  reply(ok(req, scene_json(*world.sim().latest())));
 }
 
 void get_scenes(const Request& req, ServerContext&, const Reply& reply) {
   reply(ok(req, {{"scenes", bundled_scene_names()}}));
 }
 
-void get_state(const Request& req, ServerContext& ctx, const Reply& reply) {
-  reply(ok(req, state_json(*ctx.sim.latest())));
+void get_state(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  reply(ok(req, state_json(*world.sim().latest())));
 }
 
 void get_metrics(const Request& req, ServerContext& ctx, const Reply& reply) {
+  std::vector<WorldGauges> gauges;
+  for (const auto& world : ctx.worlds.list()) {
+    const auto snap = world->sim().latest();
+    gauges.push_back({world->id(), snap->real_time_factor, snap->time, snap->bodies->size(),
+                      snap->awake, world->broadcaster().viewers(), snap->paused});
+  }
   Response res{http::status::ok, req.version()};
   res.set(http::field::content_type, "text/plain; version=0.0.4; charset=utf-8");
   res.keep_alive(req.keep_alive());
-  res.body() = ctx.metrics.render(*ctx.sim.latest(), ctx.broadcaster.viewers());
+  res.body() = ctx.metrics.render(*ctx.worlds.default_world()->sim().latest(),
+                                  ctx.worlds.viewers()) +
+               render_world_gauges(gauges);
   res.prepare_payload();
   reply(std::move(res));
 }
 
-constexpr Route kRoutes[] = {
-    {"/api/health", http::verb::get, get_health},
+// ---- Worlds ----------------------------------------------------------------------------
+
+json world_json(HostedWorld& world) {
+  const auto snap = world.sim().latest();
+  return {{"id", world.id()},
+          {"scene", snap->scene->scene.world.name},
+          {"bodies", snap->bodies->size()},
+          {"viewers", world.broadcaster().viewers()},
+          {"real_time_factor", snap->real_time_factor},
+          {"paused", snap->paused},
+          {"time", snap->time}};
+}
+
+void get_worlds(const Request& req, ServerContext& ctx, const Reply& reply) {
+  json worlds = json::array();
+  for (const auto& world : ctx.worlds.list()) worlds.push_back(world_json(*world));
+  reply(ok(req, {{"worlds", std::move(worlds)}, {"max_worlds", ctx.worlds.max_worlds()}}));
+}
+
+void get_world(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  reply(ok(req, world_json(world)));
+}
+
+// The scene a PUT names is its identity: the same name (or the same scene object, whose JSON
+// nlohmann keeps with sorted keys) makes the PUT idempotent; anything else is a conflict.
+void put_world(const Request& req, ServerContext& ctx, std::string_view id, const Reply& reply) {
+  const json body = parse_body(req);
+  only_keys(body, {"scene"});
+  const json& scene = required(body, "scene");
+  const std::string key = scene.is_string() ? scene.get<std::string>() : scene.dump();
+  CreateResult r = ctx.worlds.create(std::string(id), key, scene_from_request(scene, ctx.options));
+  switch (r.refusal) {
+    case CreateRefusal::bad_id:
+      throw Refusal{400, "a world id is 1 to 64 of a-z, 0-9 and '-'", "id"};
+    case CreateRefusal::conflict:
+      throw Refusal{409, "world '" + std::string(id) + "' exists with another scene", "scene"};
+    case CreateRefusal::too_many:
+      throw Refusal{429,
+                    "this server holds its most worlds (" +
+                        std::to_string(ctx.worlds.max_worlds()) + ", --max-worlds)",
+                    ""};
+    case CreateRefusal::none:
+      break;
+  }
+  r.world->touch();
+  json answer = world_json(*r.world);
+  answer.erase("viewers");
+  if (r.created) answer["token"] = r.world->token();
+  reply(json_response(req.version(), req.keep_alive(), r.created ? 201 : 200, answer));
+}
+
+void delete_world(const Request& req, ServerContext& ctx, HostedWorld& world,
+                  const Reply& reply) {
+  require_empty_body(req);
+  if (world.id() == kDefaultWorld) throw Refusal{409, "the default world cannot be deleted", "id"};
+  if (!ctx.worlds.remove(world.id()))
+    throw Refusal{404, "no world '" + world.id() + "'", "world"};
+  reply(ok(req, {{"ok", true}}));
+}
+
+/// Routes of one world, unprefixed for the default world and under /api/worlds/{id}.
+constexpr WorldRoute kWorldRoutes[] = {
     {"/api/scene", http::verb::get, get_scene},
-    {"/api/scenes", http::verb::get, get_scenes},
     {"/api/state", http::verb::get, get_state},
-    {"/metrics", http::verb::get, get_metrics},
     {"/api/reset", http::verb::post, post_reset},
     {"/api/pause", http::verb::post, post_pause},
     {"/api/resume", http::verb::post, post_resume},
     {"/api/step", http::verb::post, post_step},
     {"/api/impulse", http::verb::post, post_impulse},
     {"/api/integrator", http::verb::post, post_integrator},
+};
+
+/// Routes of the server as a whole.
+constexpr ServerRoute kServerRoutes[] = {
+    {"/api/health", http::verb::get, get_health},
+    {"/api/scenes", http::verb::get, get_scenes},
+    {"/api/worlds", http::verb::get, get_worlds},
+    {"/metrics", http::verb::get, get_metrics},
 };
 
 // ---- Access checks ---------------------------------------------------------------------
@@ -261,6 +359,133 @@ std::string_view path_of(std::string_view target) {
   return target.substr(0, target.find_first_of("?#"));
 }
 
+// What a request path addresses: a route of the server, a route of one world (unprefixed:
+// the default world), or a world itself (/api/worlds/{id}).
+struct Target {
+  enum class Kind { none, server, world_route, world } kind = Kind::none;
+  std::string_view id;                    // The world's id (world_route, world).
+  const ServerRoute* server = nullptr;    // Kind::server.
+  std::string_view route;                 // Kind::world_route: "/state", "/reset", …
+};
+
+Target parse_target(std::string_view path) {
+  constexpr std::string_view kWorlds = "/api/worlds/";
+  if (path.starts_with(kWorlds)) {
+    const std::string_view rest = path.substr(kWorlds.size());
+    const std::size_t slash = rest.find('/');
+    if (slash == std::string_view::npos) return {Target::Kind::world, rest};
+    return {Target::Kind::world_route, rest.substr(0, slash), nullptr, rest.substr(slash)};
+  }
+  for (const ServerRoute& r : kServerRoutes)
+    if (r.path == path) return {Target::Kind::server, {}, &r};
+  if (path.starts_with("/api/"))
+    return {Target::Kind::world_route, kDefaultWorld, nullptr, path.substr(4)};
+  return {};
+}
+
+// The route of world route `route` ("/state") for `method` (null if none), and the methods
+// the path allows ("" if the path is no route).
+const WorldRoute* find_world_route(std::string_view route, http::verb method,
+                                   std::string& allow) {
+  for (const WorldRoute& r : kWorldRoutes) {
+    if (r.path.substr(4) != route) continue;
+    allow = r.method == http::verb::get ? "GET, HEAD" : "POST";
+    if (r.method == method || (r.method == http::verb::get && method == http::verb::head))
+      return &r;
+  }
+  return nullptr;
+}
+
+Response unauthorised(const Request& req) {
+  Response res = error_response(req, 401, "missing or wrong bearer token", "Authorization");
+  res.set(http::field::www_authenticate, "Bearer realm=\"tumble\"");
+  return res;
+}
+
+bool is_get(http::verb method) { return method == http::verb::get || method == http::verb::head; }
+
+// PUT /api/worlds/{id} (needs --token when the server has one), GET and DELETE.
+void serve_world(const Request& req, ServerContext& ctx, const Target& t, const Reply& answer) {
+  const ServerOptions& options = ctx.options;
+  if (req.method() == http::verb::put) {
+    if (!authorised(req, options)) return answer(unauthorised(req));
+    if (!origin_allowed(req, options))
+      throw Refusal{403, "requests from this origin are not allowed", "Origin"};
+    return put_world(req, ctx, t.id, answer);
+  }
+  const std::shared_ptr<HostedWorld> world = ctx.worlds.find(t.id);
+  if (!world) throw Refusal{404, "no world '" + std::string(t.id) + "'", "world"};
+  if (is_get(req.method())) {
+    if (options.token_reads && !may_steer(req, options, *world)) return answer(unauthorised(req));
+    return get_world(req, ctx, *world, answer);
+  }
+  if (!may_steer(req, options, *world)) return answer(unauthorised(req));
+  if (!origin_allowed(req, options))
+    throw Refusal{403, "requests from this origin are not allowed", "Origin"};
+  delete_world(req, ctx, *world, answer);
+}
+
+void serve_world_route(const Request& req, ServerContext& ctx, const Target& t,
+                       const WorldRoute& route, const Reply& answer) {
+  const ServerOptions& options = ctx.options;
+  const std::shared_ptr<HostedWorld> world = ctx.worlds.find(t.id);
+  if (!world) throw Refusal{404, "no world '" + std::string(t.id) + "'", "world"};
+  const bool post = route.method == http::verb::post;
+  if ((post || options.token_reads) && !may_steer(req, options, *world))
+    return answer(unauthorised(req));
+  if (post && !origin_allowed(req, options))
+    throw Refusal{403, "requests from this origin are not allowed", "Origin"};
+  world->touch();
+  route.handler(req, ctx, *world, answer);
+}
+
+void dispatch(const Request& req, ServerContext& ctx, const Reply& answer) {
+  const ServerOptions& options = ctx.options;
+  const std::string_view path = path_of(req.target());
+  const Target t = parse_target(path);
+  std::string allow;
+  const WorldRoute* world_route = nullptr;
+  switch (t.kind) {
+    case Target::Kind::none: break;
+    case Target::Kind::server: allow = "GET, HEAD"; break;
+    case Target::Kind::world: allow = "GET, HEAD, PUT, DELETE"; break;
+    case Target::Kind::world_route:
+      world_route = find_world_route(t.route, req.method(), allow);
+      break;
+  }
+  if (allow.empty()) throw Refusal{404, "no such route: " + quoted_prefix(path), ""};
+  if (req.method() == http::verb::options && !options.allowed_origin.empty()) {
+    Response res{http::status::no_content, req.version()};
+    res.set(http::field::allow, allow);
+    res.set(http::field::access_control_allow_methods, allow);
+    res.set(http::field::access_control_allow_headers, "Content-Type, Authorization");
+    res.set(http::field::access_control_max_age, "600");
+    res.keep_alive(req.keep_alive());
+    res.prepare_payload();
+    return answer(std::move(res));
+  }
+  const bool allowed = t.kind == Target::Kind::world_route
+                           ? world_route != nullptr
+                           : allow.find(std::string(to_string(req.method()))) != std::string::npos;
+  if (!allowed) {
+    Response res = error_response(req, 405, "method not allowed", "");
+    res.set(http::field::allow, allow);
+    return answer(std::move(res));
+  }
+  if (t.kind != Target::Kind::server && !valid_world_id(t.id))
+    throw Refusal{400, "a world id is 1 to 64 of a-z, 0-9 and '-'", "id"};
+  switch (t.kind) {
+    case Target::Kind::server:
+      if (options.token_reads && path != "/api/health" && !authorised(req, options))
+        return answer(unauthorised(req));
+      return t.server->handler(req, ctx, answer);
+    case Target::Kind::world:
+      return serve_world(req, ctx, t, answer);
+    default:
+      return serve_world_route(req, ctx, t, *world_route, answer);
+  }
+}
+
 }  // namespace
 
 bool token_matches(std::string_view given, std::string_view expected) {
@@ -270,15 +495,17 @@ bool token_matches(std::string_view given, std::string_view expected) {
   return diff == 0;
 }
 
-bool authorised(const Request& req, const ServerOptions& options) {
-  if (options.token.empty()) return true;
+std::string_view bearer_token(const Request& req) {
   const std::string_view auth = req[http::field::authorization];
   constexpr std::string_view kScheme = "bearer ";
-  if (auth.size() < kScheme.size()) return token_matches({}, options.token);
-  std::string scheme(auth.substr(0, kScheme.size()));
-  std::transform(scheme.begin(), scheme.end(), scheme.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return scheme == kScheme && token_matches(auth.substr(kScheme.size()), options.token);
+  if (auth.size() < kScheme.size()) return {};
+  for (std::size_t i = 0; i < kScheme.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(auth[i])) != kScheme[i]) return {};
+  return auth.substr(kScheme.size());
+}
+
+bool authorised(const Request& req, const ServerOptions& options) {
+  return options.token.empty() || token_matches(bearer_token(req), options.token);
 }
 
 bool is_api_target(std::string_view target) {
@@ -303,55 +530,66 @@ Response error_response(const Request& req, unsigned status, std::string_view me
                        {{"error", message}, {"field", field}});
 }
 
+bool may_steer(const Request& req, const ServerOptions& options, const HostedWorld& world) {
+  if (world.token().empty()) return authorised(req, options);
+  const std::string_view given = bearer_token(req);
+  return token_matches(given, world.token()) ||
+         (!options.token.empty() && token_matches(given, options.token));
+}
+
+std::shared_ptr<HostedWorld> world_of_target(std::string_view target, ServerContext& ctx) {
+  const Target t = parse_target(path_of(target));
+  if (t.kind != Target::Kind::world_route && t.kind != Target::Kind::world) return nullptr;
+  return ctx.worlds.find(t.id);
+}
+
+unsigned outcome_status(const CommandOutcome& outcome) {
+  const auto* error = std::get_if<CommandError>(&outcome);
+  if (!error) return 200;
+  switch (error->failure) {
+    case Failure::invalid: return 400;
+    case Failure::not_found: return 404;
+    case Failure::conflict: return 409;
+    case Failure::unavailable: return 503;
+    case Failure::internal: return 500;
+  }
+  return 500;
+}
+
+json outcome_json(const CommandOutcome& outcome) {
+  struct Visitor {
+    json operator()(const CommandError& e) const {
+      return {{"error", e.message}, {"field", e.field}};
+    }
+    json operator()(const PausedState& p) const { return {{"ok", true}, {"paused", p.paused}}; }
+    json operator()(const SceneReset& r) const { return {{"ok", true}, {"scene", r.scene}}; }
+    json operator()(const IntegratorSet& i) const {
+      return {{"ok", true}, {"integrator", std::string(to_string(i.integrator))}};
+    }
+    json operator()(const ImpulseApplied&) const { return {{"ok", true}}; }
+    json operator()(const StepReport& r) const {
+      json body{{"ok", true},           {"time", r.time},
+                {"step", r.step},       {"steps_requested", r.requested},
+                {"steps_done", r.done}, {"complete", r.stopped == nullptr}};
+      if (r.stopped) body["stopped"] = r.stopped;
+      return body;
+    }
+  };
+  return std::visit(Visitor{}, outcome);
+}
+
 void handle_api(const Request& req, ServerContext& ctx, Reply reply) {
-  const ServerOptions& options = ctx.options;
   // Every response passes through here so that CORS headers are added in one place; it
-  // may run after `req` is gone (on the simulation thread), so it copies what it needs.
-  Reply answer = [cors = cors_origin(req, options), reply = std::move(reply)](Response res) {
+  // may run after `req` is gone (on a simulation thread), so it copies what it needs.
+  Reply answer = [cors = cors_origin(req, ctx.options), reply = std::move(reply)](Response res) {
     if (!cors.empty()) {
       res.set(http::field::access_control_allow_origin, cors);
       res.set(http::field::vary, "Origin");
     }
     reply(std::move(res));
   };
-  const std::string_view path = path_of(req.target());
-  std::string allow;
-  const Route* route = nullptr;
-  for (const Route& r : kRoutes) {
-    if (r.path != path) continue;
-    allow = r.method == http::verb::get ? "GET, HEAD" : "POST";
-    if (r.method == req.method() || (r.method == http::verb::get && req.method() == http::verb::head))
-      route = &r;
-  }
   try {
-    if (allow.empty()) throw Refusal{404, "no such route: " + quoted_prefix(path), ""};
-    if (req.method() == http::verb::options && !options.allowed_origin.empty()) {
-      Response res{http::status::no_content, req.version()};
-      res.set(http::field::allow, allow);
-      res.set(http::field::access_control_allow_methods, allow);
-      res.set(http::field::access_control_allow_headers, "Content-Type, Authorization");
-      res.set(http::field::access_control_max_age, "600");
-      res.keep_alive(req.keep_alive());
-      res.prepare_payload();
-      return answer(std::move(res));
-    }
-    if (!route) {
-      Response res = error_response(req, 405, "method not allowed", "");
-      res.set(http::field::allow, allow);
-      return answer(std::move(res));
-    }
-    const bool guarded = route->method == http::verb::post ||
-                         (options.token_reads && route->path != "/api/health");
-    if (guarded) {
-      if (!authorised(req, options)) {
-        Response res = error_response(req, 401, "missing or wrong bearer token", "Authorization");
-        res.set(http::field::www_authenticate, "Bearer realm=\"tumble\"");
-        return answer(std::move(res));
-      }
-    }
-    if (route->method == http::verb::post && !origin_allowed(req, options))
-      throw Refusal{403, "requests from this origin are not allowed", "Origin"};
-    route->handler(req, ctx, answer);
+    dispatch(req, ctx, answer);
   } catch (const Refusal& r) {
     answer(error_response(req, r.status, r.message, r.field));
   } catch (const std::exception& e) {

@@ -38,13 +38,12 @@ Server::Server(ServerOptions options, Scene scene)
     : options_(std::move(options)),
       connections_(static_cast<std::size_t>(options_.max_connections)),
       read_budget_(options_.read_budget, options_.read_budget),
-      sim_(std::move(scene), metrics_, std::chrono::milliseconds(options_.step_budget_ms),
-           static_cast<unsigned>(options_.sim_threads)),
+      pool_(options_.sim_threads > 0 ? static_cast<unsigned>(options_.sim_threads)
+                                     : World::hardware_threads()),
       ioc_(options_.threads),
-      broadcaster_(ioc_, sim_, metrics_, std::chrono::milliseconds(options_.render_ms),
-                   static_cast<std::size_t>(options_.max_viewers)),
-      ctx_{options_,  canonical_root(options_.web_root), sim_, broadcaster_, metrics_,
-           connections_, read_budget_, static_cache_} {
+      worlds_(ioc_, pool_, metrics_, options_, std::move(scene)),
+      ctx_{options_,     canonical_root(options_.web_root), worlds_, metrics_, connections_,
+           read_budget_, static_cache_} {
   ctx_.web_root_fd = web_root_fd_ = open_root(ctx_.web_root);
 }
 
@@ -58,23 +57,20 @@ void Server::start() {
   listener_ = std::make_shared<Listener>(ioc_, endpoint, ctx_);
   work_.emplace(ioc_.get_executor());
   listener_->run();
-  broadcaster_.start();
-  sim_.start();
+  worlds_.start();
   for (int i = 0; i < options_.threads; ++i) threads_.emplace_back([this] { run_io(); });
 }
 
 void Server::stop() {
   if (stopped_.exchange(true)) return;
+  if (listener_) listener_->stop();
+  worlds_.stop();  // Every loop leaves the pool; viewers get close frames.
   if (listener_) {
-    listener_->stop();
-    broadcaster_.stop();
-    broadcaster_.close_all();
     // Viewers answer the close frame; give them a moment, then cut what is left.
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
-    while (broadcaster_.viewers() > 0 && std::chrono::steady_clock::now() < deadline)
+    while (worlds_.viewers() > 0 && std::chrono::steady_clock::now() < deadline)
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  sim_.stop();
   work_.reset();
   ioc_.stop();
   for (std::thread& t : threads_) t.join();

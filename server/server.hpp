@@ -17,17 +17,17 @@
 #include <boost/asio/io_context.hpp>
 
 #include "admission.hpp"
-#include "broadcaster.hpp"
 #include "context.hpp"
 #include "metrics.hpp"
 #include "options.hpp"
-#include "sim_loop.hpp"
+#include "sim_pool.hpp"
+#include "worlds.hpp"
 
 namespace tumble::server {
 
 class Listener;
 
-/// io_context + I/O threads, the simulation thread, the broadcaster and the listener.
+/// io_context + I/O threads, the simulation threads, the worlds and the listener.
 class Server {
  public:
   /// Builds everything (throws tumble::InvalidInput for an invalid scene); nothing runs yet.
@@ -47,14 +47,16 @@ class Server {
   std::uint16_t port() const;
   /// The viewer's URL, e.g. "http://127.0.0.1:8080/".
   std::string url() const;
-  /// The simulation (for tests).
-  SimLoop& sim() { return sim_; }
+  /// The default world's simulation (for tests).
+  SimLoop& sim() { return worlds_.default_world()->sim(); }
   /// The metrics (for tests).
   const Metrics& metrics() const { return metrics_; }
-  /// Connected viewers.
-  std::size_t viewers() const { return broadcaster_.viewers(); }
-  /// The broadcaster (its frame store, for tests).
-  Broadcaster& broadcaster() { return broadcaster_; }
+  /// Connected viewers, all worlds.
+  std::size_t viewers() const { return worlds_.viewers(); }
+  /// The default world's broadcaster (its frame store, for tests).
+  Broadcaster& broadcaster() { return worlds_.default_world()->broadcaster(); }
+  /// The worlds (for tests).
+  WorldRegistry& worlds() { return worlds_; }
   /// Open connections (HTTP and WebSocket).
   std::size_t connections() const { return connections_.open(); }
   /// The I/O context (for tests that post work to the I/O threads).
@@ -63,17 +65,18 @@ class Server {
  private:
   void run_io();
 
-  // Destruction runs bottom-up: the listener and broadcaster (timers) go before the
-  // io_context, whose destruction frees the sessions; the simulation is stopped in stop().
+  // Destruction runs bottom-up: the listener and the worlds (timers) go before the
+  // io_context, whose destruction frees the sessions; the pool outlives every world's loop
+  // (stop() takes them out of it).
   ServerOptions options_;
   Metrics metrics_;
   ConnectionCount connections_;
   ReadBudget read_budget_;
   StaticCache static_cache_;
   int web_root_fd_ = -1;
-  SimLoop sim_;
+  SimPool pool_;
   boost::asio::io_context ioc_;
-  Broadcaster broadcaster_;
+  WorldRegistry worlds_;
   ServerContext ctx_;
   std::shared_ptr<Listener> listener_;
   std::optional<boost::asio::executor_work_guard<boost::asio::io_context::executor_type>> work_;

@@ -19,7 +19,7 @@ std::shared_ptr<const std::vector<BodyPose>> poses_of(const World& world) {
   return poses;
 }
 
-void complete(Command& command, CommandResult result) {
+void complete(Command& command, CommandOutcome result) {
   if (!command.done) return;
   try {
     command.done(std::move(result));
@@ -31,11 +31,11 @@ void complete(Command& command, CommandResult result) {
 }  // namespace
 
 SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_command_budget,
-                 unsigned sim_threads)
+                 unsigned step_threads)
     : metrics_(metrics),
       world_(std::make_unique<World>(std::move(scene))),
       step_command_budget_(step_command_budget) {
-  world_->set_threads(sim_threads);
+  world_->set_threads(step_threads);
   new_scene_info();
   anchor(Clock::now());
   publish(Change::restart);
@@ -43,41 +43,41 @@ SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_c
 
 SimLoop::~SimLoop() { stop(); }
 
-void SimLoop::start() {
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+void SimLoop::attach(SimPool& pool) {
+  pool_.store(&pool);
+  queue_.set_wake([this] {
+    if (SimPool* p = pool_.load()) p->wake(*this);
+  });
+  anchor(Clock::now());
+  pool.add(*this);
 }
 
 void SimLoop::stop() {
   queue_.close();
-  if (thread_.joinable()) thread_.join();
+  if (stopped_.exchange(true)) return;
+  if (SimPool* p = pool_.load()) p->remove(*this);
+  // No pool thread runs this loop any more: answer what is left here.
+  if (running_step_) finish_step("shutdown");
+  for (Command& c : queue_.drain())
+    complete(c, command_error(Failure::unavailable, "shutting down", ""));
 }
 
-void SimLoop::run() {
-  anchor(Clock::now());
-  while (true) {
-    for (Command& c : queue_.drain()) execute(c);
-    if (queue_.closed()) break;
-    if (running_step_) {
-      continue_step();
-      continue;
-    }
-    if (paused_) {
-      queue_.wait();  // Paused: sleep until a command arrives; no CPU is used.
-      continue;
-    }
-    try {
-      advance();
-    } catch (const std::exception& e) {  // std::bad_alloc above all: the process lives on.
-      on_step_failure(e);
-      continue;
-    }
-    // Sleep until the wall clock reaches the sim time just computed, or a command arrives.
-    queue_.wait_until(anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
-                                         std::chrono::duration<double>(
-                                             world_->time() - anchor_sim_)));
+Clock::time_point SimLoop::service() {
+  for (Command& c : queue_.drain()) execute(c);
+  if (running_step_) {
+    continue_step();
+    return Clock::now();
   }
-  if (running_step_) finish_step("shutdown");
-  for (Command& c : queue_.drain()) complete(c, command_error(503, "shutting down", ""));
+  if (paused_) return Clock::time_point::max();  // Only a command brings work; no CPU used.
+  try {
+    advance();
+  } catch (const std::exception& e) {  // std::bad_alloc above all: the process lives on.
+    on_step_failure(e);
+    return Clock::time_point::max();
+  }
+  // Due when the wall clock reaches the sim time just computed.
+  return anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
+                            std::chrono::duration<double>(world_->time() - anchor_sim_));
 }
 
 // An allocation failure inside a step leaves the world as that step left it (World::step is
@@ -181,7 +181,8 @@ void SimLoop::execute(Command& command) {
   const bool is_step = std::holds_alternative<StepCommand>(command.kind);
   if (running_step_) {
     if (is_step)
-      return complete(command, command_error(409, "a step is already running", "steps"));
+      return complete(command,
+                      command_error(Failure::conflict, "a step is already running", "steps"));
     // Pause, resume and reset cancel the running step; impulses and integrator changes
     // apply between its chunks.
     if (!std::holds_alternative<ImpulseCommand>(command.kind) &&
@@ -189,27 +190,27 @@ void SimLoop::execute(Command& command) {
       finish_step("cancelled");
   }
   if (is_step) return start_step(command);
-  CommandResult result;
+  CommandOutcome result;
   try {
     result = run_command(command.kind);
   } catch (const InvalidInput& e) {
-    result = command_error(400, e.what(), "");
+    result = command_error(Failure::invalid, e.what(), "");
   } catch (const std::bad_alloc&) {
     metrics_.count_step_failure();
-    result = command_error(503, "out of memory: the command was not applied", "");
+    result = command_error(Failure::unavailable, "out of memory: the command was not applied", "");
   } catch (const std::exception& e) {
-    result = command_error(500, e.what(), "");
+    result = command_error(Failure::internal, e.what(), "");
   }
   complete(command, std::move(result));
 }
 
-CommandResult SimLoop::run_command(CommandKind& kind) {
+CommandOutcome SimLoop::run_command(CommandKind& kind) {
   if (auto* c = std::get_if<ResetCommand>(&kind)) return reset(*c);
   if (auto* c = std::get_if<ImpulseCommand>(&kind)) return impulse(*c);
   if (auto* c = std::get_if<SetIntegratorCommand>(&kind)) {
     world_->set_integrator(c->integrator);
     publish(Change::command);
-    return {200, {{"ok", true}, {"integrator", std::string(to_string(c->integrator))}}};
+    return IntegratorSet{c->integrator};
   }
   const bool pause = std::holds_alternative<PauseCommand>(kind);
   if (pause != paused_) {
@@ -217,10 +218,10 @@ CommandResult SimLoop::run_command(CommandKind& kind) {
     if (!paused_) anchor(Clock::now());
     publish(Change::command);
   }
-  return {200, {{"ok", true}, {"paused", paused_}}};
+  return PausedState{paused_};
 }
 
-CommandResult SimLoop::reset(ResetCommand& c) {
+CommandOutcome SimLoop::reset(ResetCommand& c) {
   Scene scene = c.scene ? std::move(*c.scene) : world_->scene();
   std::unique_ptr<World> world;
   try {
@@ -230,19 +231,20 @@ CommandResult SimLoop::reset(ResetCommand& c) {
     // The engine names the field first ("bodies: more than 65024 pairs …"): no change here.
     const std::string what = e.what();
     const std::size_t colon = what.find(": ");
-    return command_error(400, what,
+    return command_error(Failure::invalid, what,
                          colon == std::string::npos ? "scene" : "scene." + what.substr(0, colon));
   }
   world_ = std::move(world);
   new_scene_info();
   anchor(Clock::now());
   publish(Change::restart);
-  return {200, {{"ok", true}, {"scene", world_->scene().world.name}}};
+  return SceneReset{world_->scene().world.name};
 }
 
 void SimLoop::start_step(Command& command) {
   if (!paused_)
-    return complete(command, command_error(409, "step is only allowed while paused", "steps"));
+    return complete(command, command_error(Failure::conflict, "step is only allowed while paused",
+                                           "steps"));
   const std::uint32_t steps = std::get<StepCommand>(command.kind).steps;
   running_step_.emplace(
       RunningStep{std::move(command), steps, 0, Clock::now() + step_command_budget_});
@@ -275,29 +277,25 @@ void SimLoop::continue_step() {
 void SimLoop::finish_step(const char* stopped) {
   RunningStep r = std::move(*running_step_);
   running_step_.reset();
-  CommandResult result{200, {{"ok", true}}};
+  CommandOutcome result;
   try {
     publish(Change::restart);
-    result.body["time"] = world_->time();
-    result.body["step"] = world_->step_count();
-    result.body["steps_requested"] = r.requested;
-    result.body["steps_done"] = r.done;
-    result.body["complete"] = stopped == nullptr;
-    if (stopped) result.body["stopped"] = stopped;
+    result = StepReport{world_->time(), world_->step_count(), r.requested, r.done, stopped};
   } catch (const std::exception&) {
-    result = command_error(503, "out of memory", "");
+    result = command_error(Failure::unavailable, "out of memory", "");
   }
   complete(r.command, std::move(result));
 }
 
-CommandResult SimLoop::impulse(const ImpulseCommand& c) {
+CommandOutcome SimLoop::impulse(const ImpulseCommand& c) {
   BodyId id = 0;
   if (const auto* index = std::get_if<BodyId>(&c.body)) {
     if (*index >= world_->bodies().size())
-      return command_error(404, "no body with index " + std::to_string(*index), "body");
+      return command_error(Failure::not_found, "no body with index " + std::to_string(*index), "body");
     id = *index;
   } else if (!world_->find_body(std::get<std::string>(c.body), id)) {
-    return command_error(404, "no body named '" + quoted_prefix(std::get<std::string>(c.body)) + "'",
+    return command_error(Failure::not_found,
+                         "no body named '" + quoted_prefix(std::get<std::string>(c.body)) + "'",
                          "body");
   }
   // Bounded in total, not only per kick: the body's speed and spin after this impulse.
@@ -309,17 +307,17 @@ CommandResult SimLoop::impulse(const ImpulseCommand& c) {
   const double speed = velocity(after, b.c).norm();
   const double spin = angular_velocity(after, b.c).norm();
   if (speed > kMaxSpeed && speed > velocity(b.s, b.c).norm())
-    return command_error(400, "the impulse would give the body a speed over 1000 m/s",
+    return command_error(Failure::invalid, "the impulse would give the body a speed over 1000 m/s",
                          "impulse");
   if (spin > kMaxSpin && spin > angular_velocity(b.s, b.c).norm())
-    return command_error(400, "the impulse would give the body a spin over 1000 rad/s",
+    return command_error(Failure::invalid, "the impulse would give the body a spin over 1000 rad/s",
                          "impulse");
   if (c.point)
     world_->apply_impulse(id, c.impulse, *c.point);
   else
     world_->apply_impulse(id, c.impulse);
   publish(Change::command);
-  return {200, {{"ok", true}}};
+  return ImpulseApplied{};
 }
 
 }  // namespace tumble::server

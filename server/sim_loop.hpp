@@ -1,12 +1,14 @@
 #pragma once
-/// The simulation thread: it alone owns the tumble::World. It runs a fixed-step real-time
-/// loop, runs the commands of I/O threads before each step and publishes an immutable
-/// Snapshot after every step and every command.
+/// One world's fixed-step real-time loop: it alone owns the tumble::World. A thread of the
+/// SimPool calls service(), which runs the commands of I/O threads, then the steps that are
+/// due, and publishes an immutable Snapshot after every step and every command; only one
+/// pool thread services a loop at a time.
 ///
 /// Usage:
+///   SimPool pool(2);
 ///   SimLoop sim(tumble::load_scene("seed"), metrics);
-///   sim.start();
-///   sim.submit({PauseCommand{}, [](CommandResult r) { … }});
+///   pool.add(sim);
+///   sim.submit({PauseCommand{}, [](CommandOutcome r) { … }});
 ///   auto snap = sim.latest();   // any thread
 ///   sim.stop();
 #include <deque>
@@ -14,11 +16,12 @@
 #include <optional>
 #include <memory>
 #include <mutex>
-#include <thread>
+#include <atomic>
 #include <utility>
 
 #include "commands.hpp"
 #include "metrics.hpp"
+#include "sim_pool.hpp"
 #include "snapshot.hpp"
 #include "tumble/world.hpp"
 
@@ -68,21 +71,28 @@ class SimLoop {
   static constexpr double kRtfMinWindow = 0.05;
 
   /// Builds the world (throws tumble::InvalidInput for an invalid scene) and publishes its
-  /// first snapshot. The loop does not run until start(). Each step runs on `sim_threads`
-  /// threads (this loop's thread and workers of the World's own; the same result for any count).
+  /// first snapshot. Nothing runs until a SimPool services it. Each step runs on
+  /// `step_threads` threads (the pool's thread and workers of the World's own; the same
+  /// result for any count).
   SimLoop(Scene scene, Metrics& metrics,
           std::chrono::milliseconds step_command_budget = std::chrono::seconds(5),
-          unsigned sim_threads = 1);
-  /// Stops the thread.
+          unsigned step_threads = 1);
+  /// Stops.
   ~SimLoop();
   SimLoop(const SimLoop&) = delete;
   SimLoop& operator=(const SimLoop&) = delete;
 
-  /// Starts the simulation thread.
-  void start();
-  /// Stops and joins it; queued and later commands complete with 503. Idempotent.
+  /// Hands the loop to `pool`, which services it from now on. Once, before any submit.
+  void attach(SimPool& pool);
+  /// Takes the loop out of its pool (waits for a running service to end); queued and later
+  /// commands complete as unavailable. Idempotent; not from a pool thread.
   void stop();
-  /// Queues a command; its completion runs on the simulation thread.
+  /// Runs queued commands, then a chunk of a running POST /api/step or the steps the
+  /// real-time clock has reached (at most kStepBudget of wall time). Returns when it next has
+  /// work: a past or present instant when still behind, max() when only a command can bring
+  /// work (paused). Called by one pool thread at a time.
+  Clock::time_point service();
+  /// Queues a command (and wakes the loop); its completion runs on a simulation thread.
   void submit(Command command) { queue_.push(std::move(command)); }
   /// The latest published snapshot (never null).
   std::shared_ptr<const Snapshot> latest() const { return latest_.load(); }
@@ -102,18 +112,17 @@ class SimLoop {
     Clock::time_point deadline;
   };
 
-  void run();
   void advance();
   void step_once();
   void execute(Command& command);
-  CommandResult run_command(CommandKind& kind);
-  CommandResult reset(ResetCommand& c);
+  CommandOutcome run_command(CommandKind& kind);
+  CommandOutcome reset(ResetCommand& c);
   void start_step(Command& command);
   void continue_step();
   void finish_step(const char* stopped);
   void world_step();
   void on_step_failure(const std::exception& e);
-  CommandResult impulse(const ImpulseCommand& c);
+  CommandOutcome impulse(const ImpulseCommand& c);
   void anchor(Clock::time_point now);
   double sim_clock(Clock::time_point now) const;
   void publish(Change change);
@@ -134,7 +143,8 @@ class SimLoop {
   std::function<void()> before_step_;
   CommandQueue queue_;
   SnapshotSlot latest_;
-  std::thread thread_;
+  std::atomic<SimPool*> pool_{nullptr};
+  std::atomic<bool> stopped_{false};
 };
 
 }  // namespace tumble::server

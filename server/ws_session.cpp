@@ -18,8 +18,10 @@ namespace websocket = beast::websocket;
 namespace net = boost::asio;
 
 WsSession::WsSession(net::ip::tcp::socket&& socket, Broadcaster& broadcaster, Metrics& metrics,
-                     std::chrono::milliseconds timeout, ConnectionCount::Slot slot)
+                     std::chrono::milliseconds timeout, ConnectionCount::Slot slot,
+                     std::shared_ptr<const void> owner)
     : ws_(std::move(socket)),
+      owner_(std::move(owner)),
       broadcaster_(broadcaster),
       metrics_(metrics),
       ping_timer_(ws_.get_executor()),

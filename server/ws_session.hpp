@@ -41,10 +41,11 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   static constexpr int kHeartbeatMs = 200;
 
   /// Takes over an accepted socket (its executor must be a strand); `timeout`: a ping left
-  /// unanswered this long drops the viewer; `slot`: its place under --max-connections.
+  /// unanswered this long drops the viewer; `slot`: its place under --max-connections;
+  /// `owner`: what holds `broadcaster` (its world), kept alive while the session lives.
   WsSession(boost::asio::ip::tcp::socket&& socket, Broadcaster& broadcaster, Metrics& metrics,
             std::chrono::milliseconds timeout = std::chrono::seconds(15),
-            ConnectionCount::Slot slot = nullptr);
+            ConnectionCount::Slot slot = nullptr, std::shared_ptr<const void> owner = nullptr);
 
   /// Completes the upgrade of `request` and starts sending.
   void run(boost::beast::http::request<boost::beast::http::string_body> request);
@@ -71,6 +72,7 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   void drop();
 
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_;
+  std::shared_ptr<const void> owner_;  // Declared before broadcaster_: outlives its use.
   Broadcaster& broadcaster_;
   Metrics& metrics_;
   boost::beast::flat_buffer read_buffer_;

@@ -36,24 +36,56 @@ TEST(Options, Defaults) {
   EXPECT_EQ(p.options->step_budget_ms, 5000);
   EXPECT_EQ(p.options->viewer_timeout_ms, 15000);
   EXPECT_EQ(p.options->read_budget, 20000);
-  EXPECT_EQ(p.options->sim_threads, 1);
+  EXPECT_EQ(p.options->sim_threads, 0);
+  EXPECT_EQ(p.options->step_threads, 1);
+  EXPECT_EQ(p.options->max_worlds, 64);
 }
 
-// --sim-threads: the threads of each physics step, 1..256; also from TUMBLE_SIM_THREADS.
+// --sim-threads: the pool all worlds share, 0 (the cores)..256; --step-threads: the threads
+// of each step, 1..256; both also from the environment.
 TEST(Options, SimThreads) {
-  const ParsedOptions p = parse({"--sim-threads", "3"});
+  const ParsedOptions p = parse({"--sim-threads", "3", "--step-threads", "2"});
   ASSERT_TRUE(p.options) << p.message;
   EXPECT_EQ(p.options->sim_threads, 3);
-  for (const char* bad : {"0", "257", "two"}) {
+  EXPECT_EQ(p.options->step_threads, 2);
+  for (const char* bad : {"-1", "257", "two"}) {
     const ParsedOptions r = parse({"--sim-threads", bad});
     EXPECT_FALSE(r.options) << bad;
     EXPECT_EQ(r.exit_code, 2) << bad;
     EXPECT_NE(r.message.find("sim-threads"), std::string::npos) << r.message;
   }
+  for (const char* bad : {"0", "257"}) {
+    const ParsedOptions r = parse({"--step-threads", bad});
+    EXPECT_FALSE(r.options) << bad;
+    EXPECT_NE(r.message.find("step-threads"), std::string::npos) << r.message;
+  }
   EnvVar env("TUMBLE_SIM_THREADS", "2");
   const ParsedOptions e = parse({});
   ASSERT_TRUE(e.options) << e.message;
   EXPECT_EQ(e.options->sim_threads, 2);
+}
+
+// The worlds' limits: each refused outside its range with exit code 2 and its name.
+TEST(Options, WorldLimits) {
+  const ParsedOptions p = parse({"--max-worlds", "3", "--max-bodies", "10", "--idle-s", "0.5",
+                                 "--idle-remove-s", "2"});
+  ASSERT_TRUE(p.options) << p.message;
+  EXPECT_EQ(p.options->max_worlds, 3);
+  EXPECT_EQ(p.options->max_bodies, 10);
+  EXPECT_EQ(p.options->idle_s, 0.5);
+  EXPECT_EQ(p.options->idle_remove_s, 2.0);
+  const std::vector<std::vector<std::string>> bad = {
+      {"--max-worlds", "0"}, {"--max-bodies", "0"}, {"--idle-s", "0"},
+      {"--idle-s", "10", "--idle-remove-s", "5"}};
+  for (const auto& args : bad) {
+    std::vector<const char*> argv;
+    for (const auto& a : args) argv.push_back(a.c_str());
+    const ParsedOptions r = parse(argv);
+    EXPECT_FALSE(r.options) << args[0];
+    EXPECT_EQ(r.exit_code, 2) << args[0];
+    EXPECT_NE(r.message.find(args.back() == "5" ? "idle-remove-s" : args[0].substr(2)),
+              std::string::npos) << r.message;
+  }
 }
 
 TEST(Options, HardeningLimits) {
