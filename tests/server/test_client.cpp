@@ -93,14 +93,15 @@ HttpReply raw_request(std::uint16_t port, const std::string& raw) {
   });
 }
 
-WsClient::WsClient(std::uint16_t port, const std::string& origin) : ws_(ioc_) {
+WsClient::WsClient(std::uint16_t port, const std::string& origin, const std::string& target)
+    : ws_(ioc_) {
   beast::get_lowest_layer(ws_).expires_after(kTimeout);
   beast::get_lowest_layer(ws_).connect(local(port));
   beast::get_lowest_layer(ws_).expires_never();
   if (!origin.empty())
     ws_.set_option(websocket::stream_base::decorator(
         [origin](websocket::request_type& req) { req.set(http::field::origin, origin); }));
-  ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws");
+  ws_.handshake("127.0.0.1:" + std::to_string(port), target);
 }
 
 std::optional<WsClient::Message> WsClient::read(std::chrono::milliseconds timeout) {

@@ -59,8 +59,10 @@ class WsClient {
     std::chrono::steady_clock::time_point at;
   };
 
-  /// Connects and completes the handshake; throws boost::system::system_error on failure.
-  explicit WsClient(std::uint16_t port, const std::string& origin = {});
+  /// Connects to `target` and completes the handshake; throws boost::system::system_error
+  /// on failure (a refused upgrade: boost::beast::websocket::error::upgrade_declined).
+  explicit WsClient(std::uint16_t port, const std::string& origin = {},
+                    const std::string& target = "/ws");
   /// The next message, or nullopt on timeout, close or error (then see last_error()).
   std::optional<Message> read(std::chrono::milliseconds timeout = std::chrono::seconds(2));
   /// Sends a text message.
