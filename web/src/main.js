@@ -6,7 +6,7 @@ import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
 import { sceneIntegrator, sceneName } from './protocol.js';
-import { adoptTokenFromFragment, currentWorld, isWorldId, worldToken } from './world.js';
+import { adoptTokenFromFragment, currentWorld, isWorldId, worldToken, worldUrl } from './world.js';
 
 /** Least time between two checks that the page's world still exists while the stream is down, ms. */
 const kWorldCheckMs = 5000;
@@ -20,6 +20,7 @@ const hud = new Hud(document.getElementById('hud'), document.getElementById('toa
 const plot = new EnergyPlot(document.getElementById('plot'), document.getElementById('energy'));
 const controls = new Controls(viewer, hud);
 hud.setWorld(world, worldToken(world) !== null);
+document.getElementById('default-world').href = worldUrl(null); // other parameters (?token=) kept
 
 function createViewer() {
   try {
