@@ -245,13 +245,16 @@ test('two worlds: a kick in one leaves the other still; a page without the token
     });
 
     await t.test('the world menu lists the worlds and joins one', async () => {
-      await pageB.getByRole('button', { name: 'World', exact: true }).click();
+      await pageB.locator('#panel .lil-title', { hasText: 'World' }).click(); // its name has lil-gui's arrow too
       const menu = pageB.getByRole('combobox', { name: 'world', exact: true });
-      await until('the menu to list both worlds', async () => {
-        const values = await menu.evaluate((el) => [...el.options].map((o) => o.value));
-        return values.includes('world-a') && values.includes('world-b');
+      // lil-gui's options carry labels only (`world-a · seed · 1 viewer · paused`).
+      const labels = await until('the menu to list both worlds', async () => {
+        const all = await menu.evaluate((el) => [...el.options].map((o) => o.textContent));
+        const ids = all.map((label) => label.split(' · ')[0]);
+        return ids.includes('world-a') && ids.includes('world-b') && ids.includes('default') ? all : null;
       });
-      await menu.selectOption('world-a');
+      t.diagnostic(`world menu: ${labels.join(' | ')}`);
+      await menu.selectOption({ label: labels.find((label) => label.startsWith('world-a ')) });
       await until('the page to open world-a', () => pageB.evaluate(() => window.tumble?.world === 'world-a' &&
         window.tumble.connected && window.tumble.framesDrawn >= 2), 30000);
       assert.ok(pageB.url().includes('world=world-a'));
@@ -261,7 +264,7 @@ test('two worlds: a kick in one leaves the other still; a page without the token
 
     await t.test('New private world creates a world with its own token and opens it', async () => {
       const { worlds: listed0 } = await getJson(base, 'worlds');
-      await pageB.getByRole('button', { name: 'World', exact: true }).click();
+      await pageB.locator('#panel .lil-title', { hasText: 'World' }).click(); // its name has lil-gui's arrow too
       await pageB.getByRole('button', { name: 'New private world', exact: true }).click();
       const id = await until('a new world to open', () => pageB.evaluate(() => window.tumble?.connected &&
         !['world-a', 'world-b'].includes(window.tumble.world) && window.tumble.world), 30000);
