@@ -3,7 +3,7 @@
 import { api } from './connection.js';
 import { currentWorld, randomWorldId, steerLink, storeWorldToken, viewLink, worldToken, worldUrl } from './world.js';
 
-/** Seconds between refreshes of the world list while the folder is open. */
+/** Time between refreshes of the world list while the folder is open, ms. */
 const kRefreshMs = 5000;
 /** At most this many worlds are listed (the menu of a busy server stays usable). */
 const kMaxListed = 50;
