@@ -1,5 +1,7 @@
-// The page's two links to the server: the /ws stream (with automatic reconnect) and the REST API.
+// The page's two links to the server: the /ws stream (with automatic reconnect) and the REST API,
+// both addressed to the page's world (world.js).
 import { decodeFrame, parseTextMessage } from './protocol.js';
+import { currentWorld, worldToken } from './world.js';
 
 /** First reconnect delay, ms; doubled after every failed attempt up to kMaxDelayMs. */
 const kFirstDelayMs = 250;
@@ -96,16 +98,23 @@ export class StreamConnection {
 }
 
 /**
- * The WebSocket URL of the page's server (same host, /ws beside the page). A `?token=` of the
- * page goes along as `access_token` (a browser's WebSocket cannot send an Authorization
- * header; the server wants it under --token-reads).
+ * The WebSocket URL of the page's world (same host, /ws beside the page, `?world=<id>` unless it
+ * is the default world). A `?token=` of the page goes along as `access_token` (a browser's
+ * WebSocket cannot send an Authorization header; the server wants it under --token-reads).
  */
 export function streamUrl() {
   const url = new URL('ws', window.location.href);
   url.protocol = url.protocol === 'https:' ? 'wss:' : 'ws:';
-  const token = new URLSearchParams(window.location.search).get('token');
+  const world = currentWorld();
+  if (world) url.searchParams.set('world', world);
+  const token = serverToken();
   if (token) url.searchParams.set('access_token', token);
   return url.href;
+}
+
+/** The server's own token, from the page's `?token=` (a server run with --token). */
+function serverToken() {
+  return new URLSearchParams(window.location.search).get('token');
 }
 
 /** Error thrown by the REST helpers: carries the server's message and offending field. */
@@ -117,13 +126,30 @@ export class ApiError extends Error {
   }
 }
 
-async function request(method, path, body) {
+/**
+ * Why two tokens: a world's own token (made when it was created, held in localStorage) lets its
+ * holder steer that world only; the server's --token (the page's `?token=`) steers every world
+ * and guards reads under --token-reads. One Authorization header goes with each request: on a
+ * POST the world's token when the page holds it, on a GET the server's when given.
+ */
+function bearer(method, world) {
+  const own = worldToken(world), server = serverToken();
+  return method === 'GET' ? server ?? own : own ?? server;
+}
+
+/** Path of a route of the page's world: `worlds/<id>/<route>`, or `<route>` for the default world. */
+function worldPath(route) {
+  const world = currentWorld();
+  return world ? `worlds/${encodeURIComponent(world)}/${route}` : route;
+}
+
+async function request(method, path, body, { world = currentWorld() } = {}) {
   const init = { method, headers: {} };
   if (body !== undefined) {
     init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
   }
-  const token = new URLSearchParams(window.location.search).get('token');
+  const token = bearer(method, world);
   if (token) init.headers.Authorization = `Bearer ${token}`;
   const response = await fetch(new URL(`api/${path}`, window.location.href), init);
   let payload = null;
@@ -138,15 +164,25 @@ async function request(method, path, body) {
   return payload;
 }
 
-/** The REST API of docs/protocol.md, one function per route. Each returns the parsed JSON. */
+/**
+ * The REST API of docs/protocol.md, one function per route. Each returns the parsed JSON. The
+ * world's routes address the page's world (`/api/worlds/<id>/…`, unprefixed for the default).
+ */
 export const api = {
   scenes: () => request('GET', 'scenes'),
-  state: () => request('GET', 'state'),
-  pause: () => request('POST', 'pause'),
-  resume: () => request('POST', 'resume'),
-  step: (steps) => request('POST', 'step', { steps }),
-  reset: (scene) => request('POST', 'reset', scene ? { scene } : undefined),
-  integrator: (integrator) => request('POST', 'integrator', { integrator }),
+  state: () => request('GET', worldPath('state')),
+  scene: () => request('GET', worldPath('scene')),
+  pause: () => request('POST', worldPath('pause')),
+  resume: () => request('POST', worldPath('resume')),
+  step: (steps) => request('POST', worldPath('step'), { steps }),
+  reset: (scene) => request('POST', worldPath('reset'), scene ? { scene } : undefined),
+  integrator: (integrator) => request('POST', worldPath('integrator'), { integrator }),
   /** impulse in N·s and point in metres, world frame. */
-  impulse: (body, impulse, point) => request('POST', 'impulse', { body, impulse, point }),
+  impulse: (body, impulse, point) => request('POST', worldPath('impulse'), { body, impulse, point }),
+  /** The server's worlds: {worlds: [{id, scene, bodies, viewers, real_time_factor, paused, time}], max_worlds}. */
+  worlds: () => request('GET', 'worlds'),
+  /** One world's entry; ApiError with status 404 when there is none. */
+  world: (id) => request('GET', `worlds/${encodeURIComponent(id)}`, undefined, { world: id }),
+  /** Creates world `id` from a bundled scene: 201 with its write token, 200 without when it exists. */
+  createWorld: (id, scene) => request('PUT', `worlds/${encodeURIComponent(id)}`, { scene }, { world: id }),
 };

@@ -1,7 +1,9 @@
-// User input: the lil-gui panel (pause / step / reset / scene / integrator / impulse), keyboard
-// shortcuts, and click-or-tap on a box to kick it.
+// User input: the lil-gui panel (pause / step / reset / scene / integrator / impulse / world),
+// keyboard shortcuts, and click-or-tap on a box to kick it.
 import GUI from 'lil-gui';
 import { api } from './connection.js';
+import { currentWorld } from './world.js';
+import { WorldMenu } from './world_menu.js';
 
 export const kIntegrators = ['euler', 'midpoint', 'rk4', 'symplectic_euler', 'splitting', 'exact'];
 
@@ -9,6 +11,11 @@ export const kIntegrators = ['euler', 'midpoint', 'rk4', 'symplectic_euler', 'sp
 const kClickSlopPx = 6;
 /** …and is released within this many ms. */
 const kClickMaxMs = 600;
+
+/** What the HUD says when a world refuses this page's commands (401). */
+export const kViewOnlyWorld = 'view only: this world belongs to another viewer; open its steer link to control it';
+/** …and when the default world of a server run with --token does. */
+export const kViewOnlyServer = 'view only: this server needs its token to steer; open the page with ?token=…';
 
 export class Controls {
   /**
@@ -51,6 +58,7 @@ export class Controls {
       .onChange((name) => this.#run(api.integrator(name), (r) => this.hud.setIntegrator(r.integrator ?? name)));
     gui.add(this.params, 'impulse', 0.1, 50, 0.1).name('impulse (N·s)');
     gui.add(this.params, 'frame').name('Frame bodies');
+    this.worldMenu = new WorldMenu(gui, this.hud);
     if (window.matchMedia('(max-width: 640px)').matches) gui.close();
     this.loadSceneList();
   }
@@ -61,6 +69,7 @@ export class Controls {
       const { scenes } = await api.scenes();
       this.sceneNames = [...new Set([...(scenes ?? []), this.params.scene].filter(Boolean))];
       this.sceneController.options(this.sceneNames); // lil-gui ≥ 0.20 updates the menu in place
+      this.worldMenu.setScenes(scenes ?? []);
     } catch (e) {
       this.hud.toast(`scene list: ${e.message}`);
     }
@@ -93,14 +102,24 @@ export class Controls {
     else this.stepButton.disable();
   }
 
-  /** Awaits a REST call; shows its error (with the offending field) as a toast. */
+  /**
+   * Awaits a REST call; shows its error (with the offending field) as a toast. A 401 means the
+   * page may watch but not steer: the HUD says so until a command goes through.
+   */
   async #run(promise, onOk) {
     try {
       const result = await promise;
+      if (this.hud.notice) this.hud.setNotice('');
       if (onOk) onOk(result);
       return result;
     } catch (e) {
-      this.hud.toast(e.field ? `${e.message} (${e.field})` : e.message);
+      if (e.status === 401) {
+        const text = currentWorld() ? kViewOnlyWorld : kViewOnlyServer;
+        this.hud.setNotice(text);
+        this.hud.toast(text);
+      } else {
+        this.hud.toast(e.field ? `${e.message} (${e.field})` : e.message);
+      }
       return null;
     }
   }

@@ -43,6 +43,31 @@ export class Hud {
     this.lastRefresh = 0;
     this.serverRtf = null;     // from the stream's status message
     this.serverRtfAt = 0;      // wall ms when it came
+    this.world = 'default';    // id of the world shown, with ' · steer' when the page may steer it
+    this.notice = '';          // a standing message (view only, …); empty when none
+  }
+
+  /** Shows which world the page follows (null: the default) and whether it holds its token. */
+  setWorld(id, canSteer) {
+    this.world = `${id ?? 'default'}${id && canSteer ? ' · steer' : ''}`;
+    this.refresh(performance.now(), true);
+  }
+
+  /** Shows a standing message under the HUD's figures (empty string clears it). */
+  setNotice(text) {
+    this.notice = text;
+    this.refresh(performance.now(), true);
+  }
+
+  /**
+   * Says that world `id` does not exist on this server and offers the default world (null
+   * hides the message). The card is #no-world in index.html.
+   */
+  setMissingWorld(id) {
+    const card = document.getElementById('no-world');
+    if (!card) return;
+    card.hidden = id === null;
+    set(this.fields['missing-world'], id === null ? '' : `'${id}'`);
   }
 
   setConnection(state, detail = {}) {
@@ -167,6 +192,8 @@ export class Hud {
     this.root.dataset.connection = document.body.dataset.connection = this.connection;
     set(f.connection, connText);
     set(f['connection-detail'], connText + retry);
+    set(f.world, this.world);
+    set(f.notice, this.notice);
     set(f.scene, this.sceneName || '—');
     set(f.integrator, this.integrator || '—');
     set(f.time, `${this.simTime.toFixed(3)} s`);

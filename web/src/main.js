@@ -1,16 +1,26 @@
 // Entry point: wires the stream to the viewer, HUD, energy plot and controls; runs the render loop.
 import { Viewer } from './viewer.js';
-import { streamUrl } from './connection.js';
+import { api, streamUrl } from './connection.js';
 import { StateReader } from './shared_state.js';
 import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
 import { sceneIntegrator, sceneName } from './protocol.js';
+import { adoptTokenFromFragment, currentWorld, isWorldId, worldToken, worldUrl } from './world.js';
+
+/** Least time between two checks that the page's world still exists while the stream is down, ms. */
+const kWorldCheckMs = 5000;
+
+// A steer link's token is taken before anything reads tokens (and leaves the address bar).
+adoptTokenFromFragment();
+const world = currentWorld();
 
 const viewer = createViewer();
 const hud = new Hud(document.getElementById('hud'), document.getElementById('toasts'));
 const plot = new EnergyPlot(document.getElementById('plot'), document.getElementById('energy'));
 const controls = new Controls(viewer, hud);
+hud.setWorld(world, worldToken(world) !== null);
+document.getElementById('default-world').href = worldUrl(null); // other parameters (?token=) kept
 
 function createViewer() {
   try {
@@ -59,13 +69,43 @@ const handlers = {
     connects = n;
     hud.setConnection(s, detail);
     if (s === 'open' && n > 1) controls.loadSceneList();
+    if (s === 'open') hud.setMissingWorld(null);
+    else checkWorld();
   },
   error({ message }) {
     console.warn('tumble stream:', message);
   },
 };
 worker.onmessage = ({ data }) => handlers[data?.type]?.(data);
-worker.postMessage({ type: 'start', url: streamUrl() });
+if (world === null || isWorldId(world)) worker.postMessage({ type: 'start', url: streamUrl() });
+else hud.setMissingWorld(world);
+
+let worldCheckedAt = -Infinity;
+/**
+ * Why ask: a socket to a world the server does not hold is refused with 404 before the upgrade,
+ * and a browser's WebSocket reports every refusal alike. While the stream is down, GET
+ * /api/worlds/{id} now and then tells a missing world (say so, offer the default) from a server
+ * that is away (keep retrying).
+ */
+async function checkWorld() {
+  const now = performance.now();
+  if (world === null || now - worldCheckedAt < kWorldCheckMs) return;
+  worldCheckedAt = now;
+  try {
+    await api.world(world);
+    hud.setMissingWorld(null);
+  } catch (e) {
+    if (e.status === 404 || e.status === 400) hud.setMissingWorld(world);
+  }
+}
+
+// A steer link pasted over the page's own address changes only the fragment: no reload.
+window.addEventListener('hashchange', () => {
+  if (!adoptTokenFromFragment()) return;
+  hud.setWorld(world, true);
+  hud.setNotice('');
+  controls.worldMenu.updateSteer();
+});
 
 /** Draws the worker's newest state if it is newer than the one on screen. */
 function drawNewest() {
@@ -108,6 +148,10 @@ window.tumble = Object.freeze({
   get paused() { return hud.paused; },
   get scene() { return currentScene; },
   get bodies() { return viewer.bodyCount; },
+  get world() { return world ?? 'default'; },
+  get canSteer() { return worldToken(world) !== null; },
+  get notice() { return hud.notice; },
+  get worldMissing() { return !document.getElementById('no-world').hidden; },
   bodyScreenPosition: (i) => viewer.bodyScreenPosition(i),
 });
 
