@@ -1,13 +1,22 @@
 #!/usr/bin/env bash
 # Installs what a fresh Debian 12 machine lacks (as root), installs the viewer's npm modules,
 # then configures and builds the release preset. Idempotent: a second run only rebuilds.
+#
+# usage: tools/setup.sh          everything: the tests' and benchmarks' packages, every target
+#        tools/setup.sh server   only what tumble-server needs (tools/run.sh): fewer packages,
+#                                and the server target alone (42 of 114 build steps)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+mode=${1:-all}
+case "$mode" in all | server) ;; *) echo "usage: tools/setup.sh [server]" >&2; exit 2 ;; esac
 
 packages=(build-essential cmake ninja-build pkg-config git ca-certificates
   libboost1.81-dev libboost-program-options1.81-dev libeigen3-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev nodejs chromium gnuplot-nox
-  libbullet-dev libode-dev libmujoco-dev)
+  zlib1g-dev nodejs)
+if [ "$mode" = all ]; then
+  packages+=(libgtest-dev libgmock-dev libbenchmark-dev chromium gnuplot-nox
+    libbullet-dev libode-dev libmujoco-dev)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -24,5 +33,13 @@ if [ -f web/package-lock.json ] && [ ! -d web/node_modules ] || [ web/package-lo
   (cd web && npm ci --no-audit --no-fund)
 fi
 
-cmake --preset release >/dev/null
-cmake --build --preset release
+if [ "$mode" = server ]; then
+  # A first configure leaves the tests and benchmarks out (their packages are not installed);
+  # a build directory the test command already configured is kept as it is.
+  [ -f build/release/CMakeCache.txt ] ||
+    cmake --preset release -DTUMBLE_BUILD_TESTS=OFF -DTUMBLE_BUILD_BENCH=OFF >/dev/null
+  cmake --build --preset release --target tumble-server
+else
+  cmake --preset release -DTUMBLE_BUILD_TESTS=ON -DTUMBLE_BUILD_BENCH=ON >/dev/null
+  cmake --build --preset release
+fi
