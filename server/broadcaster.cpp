@@ -44,7 +44,8 @@ bool Broadcaster::join(const std::shared_ptr<WsSession>& session) {
   std::erase_if(sessions_, [](const auto& kv) { return kv.second.expired(); });
   if (sessions_.size() >= max_viewers_) return false;
   sessions_.emplace(session.get(), session);
-  net::post(strand_, [this, owner = owner_.lock()] { wake(); });  // The timer sleeps while nobody watches.
+  // The timer sleeps while nobody watches.
+  net::post(strand_, [this, owner = owner_.lock()] { wake(); });
   return true;
 }
 

@@ -41,7 +41,8 @@ std::string render_world_gauges(const std::vector<WorldGauges>& worlds) {
          [](const WorldGauges& w) { return w.real_time_factor; });
   family("tumble_world_sim_time_seconds", "Simulated time since the last reset, per world.",
          [](const WorldGauges& w) { return w.time; });
-  family("tumble_world_bodies", "Bodies, per world.", [](const WorldGauges& w) { return w.bodies; });
+  family("tumble_world_bodies", "Bodies, per world.",
+         [](const WorldGauges& w) { return w.bodies; });
   family("tumble_world_bodies_awake", "Bodies integrated each step, per world.",
          [](const WorldGauges& w) { return w.awake; });
   family("tumble_world_viewers", "Connected WebSocket viewers, per world.",

@@ -291,7 +291,8 @@ CommandOutcome SimLoop::impulse(const ImpulseCommand& c) {
   BodyId id = 0;
   if (const auto* index = std::get_if<BodyId>(&c.body)) {
     if (*index >= world_->bodies().size())
-      return command_error(Failure::not_found, "no body with index " + std::to_string(*index), "body");
+      return command_error(Failure::not_found, "no body with index " + std::to_string(*index),
+                           "body");
     id = *index;
   } else if (!world_->find_body(std::get<std::string>(c.body), id)) {
     return command_error(Failure::not_found,

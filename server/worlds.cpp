@@ -56,11 +56,13 @@ void HostedWorld::touch() {
 }
 
 Clock::duration HostedWorld::idle_for() const {
-  return Clock::now() - Clock::time_point(Clock::duration(last_used_.load(std::memory_order_relaxed)));
+  const Clock::duration used(last_used_.load(std::memory_order_relaxed));
+  return Clock::now() - Clock::time_point(used);
 }
 
 bool HostedWorld::idle_pause() {
-  if (idle_paused_.exchange(true)) return false;
+  // A world its user paused stays as it is: a later request must not resume it.
+  if (sim_.latest()->paused || idle_paused_.exchange(true)) return false;
   sim_.submit({PauseCommand{}, nullptr});
   return true;
 }
@@ -188,8 +190,8 @@ void WorldRegistry::schedule_sweep() {
   std::lock_guard lock(mutex_);
   if (stopped_) return;
   const double period = std::clamp(options_.idle_s / 4.0, 0.05, 1.0);
-  sweep_timer_.expires_after(std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(period)));
+  sweep_timer_.expires_after(
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period)));
   sweep_timer_.async_wait([this](boost::system::error_code ec) {
     if (ec) return;
     sweep_idle();

@@ -5,6 +5,8 @@
 /// `/ws` without `?world=` address it, and it is never removed. Others are created by
 /// `PUT /api/worlds/{id}` with a write token, and paused, then removed, when idle.
 #include <atomic>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <map>
 #include <memory>
@@ -13,9 +15,6 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <boost/asio/io_context.hpp>
-#include <boost/asio/steady_timer.hpp>
 
 #include "broadcaster.hpp"
 #include "commands.hpp"
@@ -61,7 +60,8 @@ class HostedWorld : public std::enable_shared_from_this<HostedWorld> {
   void touch();
   /// Wall time since it was last used.
   Clock::duration idle_for() const;
-  /// Pauses it for idleness (a touch resumes it); false if it already was.
+  /// Pauses it for idleness (a touch resumes it); false if it was paused already (by idleness
+  /// or by its user, whose pause a touch leaves alone).
   bool idle_pause();
 
  private:

@@ -65,8 +65,13 @@ std::pair<double, double> usage(pid_t pid) {
 Trial run(const Args& a, int n) {
   Trial t;
   t.worlds = n;
-  std::vector<std::string> argv = {a.server, "--port", "0", "--max-worlds", std::to_string(n + 1),
-                                   "--sim-threads", std::to_string(a.sim_threads)};
+  std::vector<std::string> argv = {a.server,
+                                   "--port",
+                                   "0",
+                                   "--max-worlds",
+                                   std::to_string(n + 1),
+                                   "--sim-threads",
+                                   std::to_string(a.sim_threads)};
   ChildProcess child(argv);
   const std::string url = child.line();
   if (url.find("http://") == std::string::npos) return t.why = "no server: " + url, t;
@@ -76,7 +81,8 @@ Trial run(const Args& a, int n) {
   for (int i = 0; i < n; ++i) {
     const HttpReply r = http_request(port, http::verb::put, "/api/worlds/w-" + std::to_string(i),
                                      R"({"scene": ")" + a.scene + "\"}");
-    if (r.status != 201) return t.why = "PUT answered " + std::to_string(r.status) + " " + r.body, t;
+    if (r.status != 201)
+      return t.why = "PUT answered " + std::to_string(r.status) + " " + r.body, t;
   }
   t.rss_per_world_kb = (usage(child.pid()).second - rss0) / n;
   std::this_thread::sleep_for(std::chrono::milliseconds(2500));
@@ -105,10 +111,11 @@ Trial run(const Args& a, int n) {
 }
 
 void print(const Trial& t) {
-  std::printf("%6d worlds: real-time factor worst %.3f mean %.3f, server CPU %.2f cores, "
-              "%.0f KiB per world  %s%s\n",
-              t.worlds, t.worst, t.mean, t.cpu, t.rss_per_world_kb, t.pass ? "pass" : "FAIL",
-              t.why.empty() ? "" : ("  (" + t.why + ")").c_str());
+  std::printf(
+      "%6d worlds: real-time factor worst %.3f mean %.3f, server CPU %.2f cores, "
+      "%.0f KiB per world  %s%s\n",
+      t.worlds, t.worst, t.mean, t.cpu, t.rss_per_world_kb, t.pass ? "pass" : "FAIL",
+      t.why.empty() ? "" : ("  (" + t.why + ")").c_str());
   std::fflush(stdout);
 }
 
@@ -118,12 +125,18 @@ int main(int argc, char** argv) {
   Args a;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
-    if (k == "--server") a.server = v;
-    else if (k == "--scene") a.scene = v;
-    else if (k == "--max") a.max = std::stoi(v);
-    else if (k == "--seconds") a.seconds = std::stod(v);
-    else if (k == "--sim-threads") a.sim_threads = std::stoi(v);
-    else return std::cerr << "server_worlds: unknown option " << k << "\n", 2;
+    if (k == "--server")
+      a.server = v;
+    else if (k == "--scene")
+      a.scene = v;
+    else if (k == "--max")
+      a.max = std::stoi(v);
+    else if (k == "--seconds")
+      a.seconds = std::stod(v);
+    else if (k == "--sim-threads")
+      a.sim_threads = std::stoi(v);
+    else
+      return std::cerr << "server_worlds: unknown option " << k << "\n", 2;
   }
   std::signal(SIGPIPE, SIG_IGN);
   std::printf("scene %s, %u cores, --sim-threads %d (0: the cores)\n", a.scene.c_str(),

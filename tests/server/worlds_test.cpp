@@ -26,8 +26,8 @@ class WorldsTest : public ServerTest {
   /// PUT /api/worlds/{id} with `scene` (JSON text).
   HttpReply put(const std::string& id, const std::string& scene,
                 const std::map<std::string, std::string>& headers = {}) {
-    return http_request(port_, http::verb::put, "/api/worlds/" + id,
-                        R"({"scene": )" + scene + "}", headers);
+    return http_request(port_, http::verb::put, "/api/worlds/" + id, R"({"scene": )" + scene + "}",
+                        headers);
   }
   /// Creates world `id` from a bundled scene and returns its token.
   std::string create(const std::string& id, const std::string& scene = "seed") {
@@ -116,9 +116,9 @@ TEST_F(WorldsTest, WriteTokens) {
     EXPECT_EQ(http_post(port_, std::string("/api/worlds/t/") + route).status, 401u) << route;
   EXPECT_EQ(post("t", "pause", other).status, 401u) << "another world's token";
   EXPECT_EQ(post("t", "pause", token).status, 200u);
-  EXPECT_EQ(http_post(port_, "/api/worlds/t/impulse", R"({"body": 0, "impulse": [1, 0, 0]})")
-                .status,
-            401u);
+  EXPECT_EQ(
+      http_post(port_, "/api/worlds/t/impulse", R"({"body": 0, "impulse": [1, 0, 0]})").status,
+      401u);
   // Reads and viewing stay open.
   EXPECT_EQ(http_get(port_, "/api/worlds/t/state").status, 200u);
   EXPECT_EQ(http_get(port_, "/api/worlds/t/scene").status, 200u);
@@ -202,6 +202,16 @@ TEST_F(WorldsTest, ARequestWakesAnIdleWorld) {
   EXPECT_EQ(http_get(port_, "/api/worlds/sleepy/state").status, 200u);
   std::this_thread::sleep_for(100ms);
   EXPECT_EQ(listed("sleepy")["paused"], false);
+}
+
+// A world its user paused is not resumed by a later request.
+TEST_F(WorldsTest, AUserPauseOutlastsIdleness) {
+  const std::string token = create("held");
+  ASSERT_EQ(post("held", "pause", token).status, 200u);
+  std::this_thread::sleep_for(700ms);  // past --idle-s
+  EXPECT_EQ(http_get(port_, "/api/worlds/held/state").status, 200u);
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(listed("held")["paused"], true);
 }
 
 // With --token the server's token creates worlds and steers every world.
