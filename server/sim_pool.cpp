@@ -24,7 +24,8 @@ SimPool::~SimPool() {
 void SimPool::add(SimLoop& loop) {
   {
     std::lock_guard lock(mutex_);
-    loops_.try_emplace(&loop, Entry{Clock::now()});
+    const auto [it, added] = loops_.try_emplace(&loop, Entry{Clock::time_point::max()});
+    if (added) queue(&loop, it->second, Clock::now());
   }
   work_.notify_one();
 }
@@ -34,6 +35,7 @@ void SimPool::remove(SimLoop& loop) {
   const auto it = loops_.find(&loop);
   if (it == loops_.end()) return;
   it->second.removing = true;  // No thread picks it up from now on.
+  ready_.erase({it->second.due, &loop});
   idle_.wait(lock, [&] { return !it->second.running; });
   loops_.erase(it);
 }
@@ -47,19 +49,17 @@ void SimPool::wake(SimLoop& loop) {
       it->second.woken = true;
       return;
     }
-    it->second.due = std::min(it->second.due, Clock::now());
+    queue(&loop, it->second, std::min(it->second.due, Clock::now()));
   }
   work_.notify_one();
 }
 
-// The idle loop whose work has been due longest (null if none is idle).
-std::pair<SimLoop* const, SimPool::Entry>* SimPool::next_due() {
-  std::pair<SimLoop* const, Entry>* best = nullptr;
-  for (auto& entry : loops_)
-    if (!entry.second.running && !entry.second.removing &&
-        (!best || entry.second.due < best->second.due))
-      best = &entry;
-  return best;
+// (Re)places an idle loop in the ready queue at `due` (max: not queued; only a wake brings
+// work). Under mutex_.
+void SimPool::queue(SimLoop* loop, Entry& entry, Clock::time_point due) {
+  ready_.erase({entry.due, loop});
+  entry.due = due;
+  if (due != Clock::time_point::max()) ready_.emplace(due, loop);
 }
 
 // Earliest-due first. A loop that finished behind the clock (its next step is already due)
@@ -70,27 +70,27 @@ std::pair<SimLoop* const, SimPool::Entry>* SimPool::next_due() {
 void SimPool::run() {
   std::unique_lock lock(mutex_);
   while (!stopping_) {
-    auto* entry = next_due();
-    if (!entry || entry->second.due == Clock::time_point::max()) {
+    if (ready_.empty()) {
       work_.wait(lock);
       continue;
     }
-    if (entry->second.due > Clock::now()) {
-      work_.wait_until(lock, entry->second.due);
+    const auto [due, loop] = *ready_.begin();
+    if (due > Clock::now()) {
+      work_.wait_until(lock, due);
       continue;
     }
-    entry->second.running = true;
-    entry->second.woken = false;
-    SimLoop& loop = *entry->first;
+    ready_.erase(ready_.begin());
+    Entry& entry = loops_.at(loop);  // Stays valid: remove() waits for running == false.
+    entry.running = true;
+    entry.woken = false;
     lock.unlock();
-    const Clock::time_point next = loop.service();
+    const Clock::time_point next = loop->service();
     lock.lock();
     const Clock::time_point now = Clock::now();
-    // `entry` is still valid: remove() waits for running == false before erasing.
-    Entry& e = entry->second;
-    e.running = false;
-    if (!e.removing) e.due = e.woken ? now : std::max(next, now);
-    idle_.notify_all();
+    entry.running = false;
+    entry.due = Clock::time_point::max();  // Not in ready_ while it ran.
+    if (!entry.removing) queue(loop, entry, entry.woken ? now : std::max(next, now));
+    if (entry.removing) idle_.notify_all();
   }
 }
 

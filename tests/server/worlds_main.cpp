@@ -1,13 +1,16 @@
 /// server_worlds: how many worlds of one scene a tumble-server keeps at real time on this
 /// machine (docs/benchmarks.md, "Worlds per server"), against a child server on 127.0.0.1:
-///   server_worlds [--server PATH] [--scene seed] [--max N] [--seconds S] [--sim-threads T]
+///   server_worlds [--server PATH] [--scene seed] [--max N] [--seconds S] [--settle S]
+///                 [--sim-threads T]
 /// For a count n it creates n worlds (PUT /api/worlds/w-i, the default world paused so it
 /// costs nothing), waits 2.5 s (the real-time factor is a 2 s window), then samples
 /// GET /api/worlds every 0.5 s for S seconds (default 4): n passes when every world's factor
 /// stays ≥ 0.99 in every sample. It doubles n from 1 while n passes, then bisects between the
 /// last pass and the first failure, each count on a fresh server. Prints per count the
-/// worst and mean factor, the server's CPU use and its memory per world; last line: the
-/// largest count that passed.
+/// worst and mean factor, the server's CPU use while sampled, its memory per world and the
+/// share of bodies awake at the end (a scene that falls asleep costs little once it has:
+/// `--settle S` waits longer before sampling, to measure that state); last line: the largest
+/// count that passed.
 #include <signal.h>
 #include <unistd.h>
 
@@ -35,6 +38,7 @@ struct Args {
   int max = 4096;
   double seconds = 4.0;
   int sim_threads = 0;
+  double settle = 2.5;
 };
 
 struct Trial {
@@ -43,6 +47,7 @@ struct Trial {
   double worst = 0, mean = 0;   // Real-time factor over worlds and samples.
   double cpu = 0;               // Server CPU seconds per wall second while sampled.
   double rss_per_world_kb = 0;  // Resident memory growth per world created, KiB.
+  double awake = 0;             // Share of bodies awake at the end (asleep bodies cost less).
   std::string why;
 };
 
@@ -85,7 +90,7 @@ Trial run(const Args& a, int n) {
       return t.why = "PUT answered " + std::to_string(r.status) + " " + r.body, t;
   }
   t.rss_per_world_kb = (usage(child.pid()).second - rss0) / n;
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  std::this_thread::sleep_for(std::chrono::duration<double>(a.settle));
   const auto [cpu0, rss1] = usage(child.pid());
   const auto start = Clock::now();
   t.worst = 1e9;
@@ -105,6 +110,16 @@ Trial run(const Args& a, int n) {
   t.cpu = (usage(child.pid()).first - cpu0) /
           std::chrono::duration<double>(Clock::now() - start).count();
   t.mean = count ? sum / count : 0;
+  double awake = 0, bodies = 0;
+  std::istringstream metrics(http_get(port, "/metrics").body);
+  for (std::string line; std::getline(metrics, line);) {
+    if (line.rfind("tumble_world_bodies_awake{", 0) == 0 &&
+        line.find("\"default\"") == std::string::npos)
+      awake += std::stod(line.substr(line.rfind(' ') + 1));
+    if (line.rfind("tumble_world_bodies{", 0) == 0 && line.find("\"default\"") == std::string::npos)
+      bodies += std::stod(line.substr(line.rfind(' ') + 1));
+  }
+  t.awake = bodies > 0 ? awake / bodies : 0;
   t.pass = count > 0 && t.worst >= 0.99;
   child.stop();
   return t;
@@ -113,8 +128,8 @@ Trial run(const Args& a, int n) {
 void print(const Trial& t) {
   std::printf(
       "%6d worlds: real-time factor worst %.3f mean %.3f, server CPU %.2f cores, "
-      "%.0f KiB per world  %s%s\n",
-      t.worlds, t.worst, t.mean, t.cpu, t.rss_per_world_kb, t.pass ? "pass" : "FAIL",
+      "%.0f KiB per world, %.0f %% of bodies awake at the end  %s%s\n",
+      t.worlds, t.worst, t.mean, t.cpu, t.rss_per_world_kb, 100 * t.awake, t.pass ? "pass" : "FAIL",
       t.why.empty() ? "" : ("  (" + t.why + ")").c_str());
   std::fflush(stdout);
 }
@@ -133,6 +148,8 @@ int main(int argc, char** argv) {
       a.max = std::stoi(v);
     else if (k == "--seconds")
       a.seconds = std::stod(v);
+    else if (k == "--settle")
+      a.settle = std::stod(v);
     else if (k == "--sim-threads")
       a.sim_threads = std::stoi(v);
     else
