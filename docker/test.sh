@@ -307,6 +307,7 @@ for cid in "${cids[@]}"; do
 done
 proxy_code=$("$DOCKER" inspect -f '{{.State.ExitCode}}' "$proxy_cid")
 log "compose stop (SIGTERM): replicas exited with codes ${codes% }, haproxy with $proxy_code, after ${T_STOP} s"
+[ "$proxy_code" = 0 ] || fail "haproxy exit code $proxy_code after SIGTERM (137: it ignored SIGTERM as PID 1)"
 # Four containers stop side by side on 2 cores: 3 s for all (each one is bounded by the grace).
 awk -v t="$T_STOP" 'BEGIN { exit !(t < 3.0) }' || fail "stopping took ${T_STOP} s (limit 3 s)"
 compose logs --no-color --tail 3 tumble | sed 's/^/    /'
