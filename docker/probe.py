@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks a running Tumble server from outside its container, with the standard library only.
 
-usage: probe.py HOST PORT
+usage: probe.py HOST PORT [WORLD ...]
 
 - GET /api/health is 200 with {"status": "ok"}
 - GET /api/state is 200 with time, step and a list of bodies
@@ -9,6 +9,10 @@ usage: probe.py HOST PORT
   from web/node_modules) is served too
 - WebSocket /ws: a raw RFC 6455 handshake, then the text scene message, then one binary frame
   whose header and length match docs/protocol.md
+
+- for each WORLD (docker/compose.scale.yaml, through HAProxy): PUT /api/worlds/WORLD with the
+  seed scene is 201 (or 200 when it exists), GET /api/worlds/WORLD/state is 200 with bodies,
+  and /ws?world=WORLD gives the scene message and a keyframe
 
 Prints one line per check; exits 1 at the first failure.
 """
@@ -24,7 +28,7 @@ import time
 import urllib.parse
 import urllib.request
 
-HOST, PORT = sys.argv[1], int(sys.argv[2])
+HOST, PORT, WORLDS = sys.argv[1], int(sys.argv[2]), sys.argv[3:]
 BASE = f"http://{HOST}:{PORT}"
 TIMEOUT = 5.0
 
@@ -46,6 +50,30 @@ def get(path):
         return e.code, e.headers.get("Content-Type", ""), e.read()
     except OSError as e:
         fail(f"GET {path}: {e}")
+
+
+def put_json(path, value):
+    req = urllib.request.Request(BASE + path, data=json.dumps(value).encode(), method="PUT",
+                                 headers={"Content-Type": "application/json"})
+    try:
+        with urllib.request.urlopen(req, timeout=TIMEOUT) as r:
+            return r.status, r.read()
+    except urllib.error.HTTPError as e:
+        return e.code, e.read()
+    except OSError as e:
+        fail(f"PUT {path}: {e}")
+
+
+def check_world(world):
+    status, body = put_json(f"/api/worlds/{world}", {"scene": "seed"})
+    if status not in (200, 201):
+        fail(f"PUT /api/worlds/{world} -> {status} {body[:200]!r}")
+    ok(f"PUT /api/worlds/{world} -> {status}")
+    status, _, body = get(f"/api/worlds/{world}/state")
+    if status != 200 or not json.loads(body).get("bodies"):
+        fail(f"GET /api/worlds/{world}/state -> {status} {body[:200]!r}")
+    ok(f"GET /api/worlds/{world}/state -> 200, t={json.loads(body)['time']:.3f} s")
+    check_websocket(f"/ws?world={world}")
 
 
 def check_rest():
@@ -136,10 +164,10 @@ def send_close(sock):
                  + bytes(c ^ mask[i % 4] for i, c in enumerate(code)))
 
 
-def check_websocket():
+def check_websocket(target="/ws"):
     key = base64.b64encode(os.urandom(16)).decode()
     sock = socket.create_connection((HOST, PORT), timeout=TIMEOUT)
-    sock.sendall((f"GET /ws HTTP/1.1\r\nHost: {HOST}:{PORT}\r\nUpgrade: websocket\r\n"
+    sock.sendall((f"GET {target} HTTP/1.1\r\nHost: {HOST}:{PORT}\r\nUpgrade: websocket\r\n"
                   f"Connection: Upgrade\r\nSec-WebSocket-Key: {key}\r\n"
                   f"Sec-WebSocket-Version: 13\r\n\r\n").encode())
     head = b""
@@ -154,7 +182,7 @@ def check_websocket():
                for l in lines[1:] if ":" in l}
     if headers.get("sec-websocket-accept") != accept:
         fail("WebSocket handshake: wrong Sec-WebSocket-Accept")
-    ok("WebSocket /ws handshake -> 101")
+    ok(f"WebSocket {target} handshake -> 101")
 
     op, data = recv_message(sock)
     if op != 1:
@@ -199,4 +227,6 @@ if __name__ == "__main__":
     check_rest()
     check_viewer()
     check_websocket()
+    for w in WORLDS:
+        check_world(w)
     print("probe: all checks passed")

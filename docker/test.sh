@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Real build-and-run test of docker/: builds the image, brings the service up with compose,
-# checks it from outside the container, stops it with SIGTERM and checks the clean exit.
+# Real build-and-run test of docker/: builds the server image and the HAProxy image, brings up
+# docker/compose.scale.yaml with 3 replicas behind HAProxy, checks it from outside (the default
+# world, then two worlds created through HAProxy, each with REST and a WebSocket), stops it with
+# SIGTERM and checks the clean exit. (docker/compose.yaml, the single server, is validated with
+# `compose config`: the scale run exercises the same image and settings.)
 #
 # It needs no Docker installation of its own: it installs Debian's docker.io, containerd, runc,
 # debootstrap and docker-compose if missing, starts a private Docker engine (state under a temp
@@ -20,6 +23,8 @@ ROOT=$PWD
 CACHE=${TUMBLE_DOCKER_CACHE:-/var/cache/tumble-docker}
 BUDGET_MB=${TUMBLE_IMAGE_BUDGET_MB:-150}
 IMAGE=tumble:latest
+PROXY_IMAGE=tumble-haproxy:latest
+REPLICAS=3
 PROJECT=tumbletest
 T_START=$(date +%s.%N)
 
@@ -70,16 +75,13 @@ fi
 # ---- private Docker engine ------------------------------------------------------------------
 # Not under /tmp if that is a tmpfs or overlay: overlay2 needs a real file system below it.
 WORK=$(mktemp -d /var/tmp/tumble-docker.XXXXXX)
-# Beside compose.yaml, so its relative build context still resolves (git-ignored).
-HOSTNET_COMPOSE=docker/.compose.hostnet.yaml
 export DOCKER_HOST=unix://$WORK/docker.sock
 DOCKERD_PID=""
 cleanup() {
   local rc=$?
   set +e
   if [ -n "$DOCKERD_PID" ] && kill -0 "$DOCKERD_PID" 2>/dev/null; then
-    "${COMPOSE[@]}" -p "$PROJECT" -f "$HOSTNET_COMPOSE" -f docker/compose.test.yaml \
-      down --timeout 2 >/dev/null 2>&1
+    "${COMPOSE[@]}" -p "$PROJECT" -f docker/compose.scale.yaml down --timeout 2 >/dev/null 2>&1
     kill -TERM "$DOCKERD_PID" 2>/dev/null
     for _ in $(seq 1 150); do kill -0 "$DOCKERD_PID" 2>/dev/null || break; sleep 0.1; done
     kill -0 "$DOCKERD_PID" 2>/dev/null && kill -KILL "$DOCKERD_PID" 2>/dev/null
@@ -205,71 +207,110 @@ awk '/^#[0-9]+ \[/ { id = $1; sub(/^#[0-9]+ /, ""); name[id] = substr($0, 1, 90)
   "$WORK/build.log" | sort -rn | head -n 6
 grep -E 'tests passed|tests failed' "$WORK/build.log" | tail -n 1 | sed 's/^#[0-9]* [0-9.]* /    ctest in the build: /' || true
 
-# ---- up, healthy, probe -------------------------------------------------------------------------
-TUMBLE_TEST_PORT=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-export TUMBLE_TEST_PORT
-# Host networking cannot publish ports, and Compose v1 merges (cannot drop) the base file's
-# `ports:` list, so the test runs docker/compose.yaml with that one block removed; everything
-# else (image, environment, read-only root, tmpfs, capabilities, healthcheck) is as shipped.
-"${COMPOSE[@]}" -f docker/compose.yaml config -q || fail "compose config (docker/compose.yaml)"
-python3 - docker/compose.yaml "$HOSTNET_COMPOSE" <<'PY' || fail "deriving the host-network compose file"
-import sys
-lines, out, skip = open(sys.argv[1]).read().splitlines(), [], False
-for line in lines:
-    if line.strip() == "ports:":
-        skip = True
-        continue
-    if skip and line.lstrip().startswith("- "):
-        continue
-    skip = False
-    out.append(line)
-open(sys.argv[2], "w").write("\n".join(out) + "\n")
-PY
-compose() { "${COMPOSE[@]}" -p "$PROJECT" -f "$HOSTNET_COMPOSE" -f docker/compose.test.yaml "$@"; }
-compose config -q || fail "compose config"
+# ---- the HAProxy image: a stage of the same Dockerfile on the same base ------------------------
 T=$(now)
-log "compose up (host network, port $TUMBLE_TEST_PORT)"
-compose up -d --no-build >"$WORK/up.log" 2>&1 || { cat "$WORK/up.log"; fail "compose up"; }
-cid=$(compose ps -q tumble)
-[ -n "$cid" ] || fail "compose up made no container"
-health=""
-for _ in $(seq 1 120); do
-  health=$("$DOCKER" inspect -f '{{.State.Health.Status}}' "$cid")
-  state=$("$DOCKER" inspect -f '{{.State.Status}}' "$cid")
-  [ "$health" = healthy ] && break
-  [ "$state" = running ] || break
-  sleep 0.25
-done
-if [ "$health" != healthy ]; then
-  compose logs --tail 40
-  "$DOCKER" inspect -f '{{json .State}}' "$cid"
-  fail "the container did not become healthy (state $state, health $health)"
+if ! DOCKER_BUILDKIT=1 "$DOCKER" build --progress plain --network host --target haproxy \
+    -t "$PROXY_IMAGE" -f docker/Dockerfile . >"$WORK/build-haproxy.log" 2>&1; then
+  tail -n 30 "$WORK/build-haproxy.log"
+  fail "docker build --target haproxy (last lines above)"
 fi
-T_HEALTHY=$(since "$T")
-log "healthy ${T_HEALTHY} s after 'compose up'"
+T_PROXY_BUILD=$(since "$T")
+PROXY_MB=$("$DOCKER" image inspect -f '{{.Size}}' "$PROXY_IMAGE" | awk '{ printf "%.1f", $1 / 1e6 }')
+log "image $PROXY_IMAGE built in ${T_PROXY_BUILD} s, ${PROXY_MB} MB"
 
+# ---- up: 3 replicas + HAProxy, healthy, probe ---------------------------------------------------
+# The private engine has no default bridge (--bridge=none), but compose's own network is a
+# user-defined bridge with Docker's DNS, which is what HAProxy finds the replicas through.
+# HAProxy alone publishes a port: a free one on 127.0.0.1.
+TUMBLE_TEST_PORT=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+export TUMBLE_PUBLISH=127.0.0.1:$TUMBLE_TEST_PORT TUMBLE_REPLICAS=$REPLICAS
+"${COMPOSE[@]}" -f docker/compose.yaml config -q || fail "compose config (docker/compose.yaml)"
+compose() { "${COMPOSE[@]}" -p "$PROJECT" -f docker/compose.scale.yaml "$@"; }
+compose config -q || fail "compose config (docker/compose.scale.yaml)"
+T=$(now)
+log "compose up --scale tumble=$REPLICAS (HAProxy on 127.0.0.1:$TUMBLE_TEST_PORT)"
+compose up -d --no-build --scale tumble=$REPLICAS >"$WORK/up.log" 2>&1 \
+  || { cat "$WORK/up.log"; fail "compose up"; }
+mapfile -t cids < <(compose ps -q tumble)
+proxy_cid=$(compose ps -q haproxy)
+[ "${#cids[@]}" = "$REPLICAS" ] || fail "compose up made ${#cids[@]} tumble containers, not $REPLICAS"
+[ -n "$proxy_cid" ] || fail "compose up made no haproxy container"
+for cid in "${cids[@]}"; do
+  health=""
+  for _ in $(seq 1 120); do
+    health=$("$DOCKER" inspect -f '{{.State.Health.Status}}' "$cid")
+    state=$("$DOCKER" inspect -f '{{.State.Status}}' "$cid")
+    [ "$health" = healthy ] && break
+    [ "$state" = running ] || break
+    sleep 0.25
+  done
+  if [ "$health" != healthy ]; then
+    compose logs --tail 40
+    "$DOCKER" inspect -f '{{json .State}}' "$cid"
+    fail "replica ${cid:0:12} did not become healthy (state $state, health $health)"
+  fi
+done
+T_HEALTHY=$(since "$T")
+log "$REPLICAS replicas healthy ${T_HEALTHY} s after 'compose up'"
+
+cid=${cids[0]}
 user=$("$DOCKER" inspect -f '{{.Config.User}}' "$cid")
 ro=$("$DOCKER" inspect -f '{{.HostConfig.ReadonlyRootfs}}' "$cid")
 uid=$("$DOCKER" exec "$cid" id -u)
 [ "$uid" != 0 ] || fail "the server runs as root"
 [ "$ro" = true ] || fail "the root file system is not read-only"
-log "runs as user '$user' (uid $uid), read-only root fs"
+puid=$("$DOCKER" exec "$proxy_cid" id -u)
+[ "$puid" != 0 ] || fail "haproxy runs as root"
+log "servers run as user '$user' (uid $uid), read-only root fs; haproxy as uid $puid"
 
-python3 docker/probe.py 127.0.0.1 "$TUMBLE_TEST_PORT" || { compose logs --tail 40; fail "probe"; }
+# HAProxy answers once it listens; its slots fill from Docker's DNS within a second of that
+# (the replicas were in the DNS before they were healthy).
+for _ in $(seq 1 40); do
+  python3 -c 'import sys, urllib.request; urllib.request.urlopen(sys.argv[1], timeout=1)' \
+    "http://127.0.0.1:$TUMBLE_TEST_PORT/haproxy-health" 2>/dev/null && break
+  sleep 0.25
+done
+sleep 1
+python3 docker/probe.py 127.0.0.1 "$TUMBLE_TEST_PORT" probe-a probe-b \
+  || { compose logs --tail 40; fail "probe through HAProxy"; }
 
-# ---- SIGTERM: a clean exit (code 0) within 2 s ------------------------------------------------
+# Each probed world is on exactly one replica (asked directly, inside its container).
+worlds_on() {
+  "$DOCKER" exec "$1" bash -c 'exec 3<>/dev/tcp/127.0.0.1/8080
+    printf "GET /api/worlds HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n" >&3
+    timeout 2 cat <&3'
+}
+placement=""
+for world in probe-a probe-b; do
+  on=()
+  for i in "${!cids[@]}"; do
+    worlds_on "${cids[$i]}" | grep -q "\"id\": *\"$world\"" && on+=("$((i + 1))")
+  done
+  [ "${#on[@]}" = 1 ] || fail "world $world is on replicas [${on[*]}], expected exactly one"
+  placement+=" $world on replica ${on[0]};"
+done
+log "placement:${placement%;}"
+
+# ---- SIGTERM: a clean exit (code 0) of every replica within the 2 s grace period --------------
 T=$(now)
 compose stop --timeout 2 >"$WORK/stop.log" 2>&1 || { cat "$WORK/stop.log"; fail "compose stop"; }
 T_STOP=$(since "$T")
-code=$("$DOCKER" inspect -f '{{.State.ExitCode}}' "$cid")
-oom=$("$DOCKER" inspect -f '{{.State.OOMKilled}}' "$cid")
-log "compose stop (SIGTERM): exited with code $code after ${T_STOP} s"
-if [ "$code" != 0 ] || [ "$oom" != false ]; then
-  compose logs --tail 40
-  fail "exit code $code after SIGTERM (137 = killed after the 2 s grace period)"
-fi
-awk -v t="$T_STOP" 'BEGIN { exit !(t < 2.0) }' || fail "stopping took ${T_STOP} s (limit 2 s)"
-compose logs --no-color --tail 5 | sed 's/^/    /'
+codes=""
+for cid in "${cids[@]}"; do
+  code=$("$DOCKER" inspect -f '{{.State.ExitCode}}' "$cid")
+  oom=$("$DOCKER" inspect -f '{{.State.OOMKilled}}' "$cid")
+  codes+="$code "
+  if [ "$code" != 0 ] || [ "$oom" != false ]; then
+    compose logs --tail 40
+    fail "replica exit code $code after SIGTERM (137 = killed after the 2 s grace period)"
+  fi
+done
+proxy_code=$("$DOCKER" inspect -f '{{.State.ExitCode}}' "$proxy_cid")
+log "compose stop (SIGTERM): replicas exited with codes ${codes% }, haproxy with $proxy_code, after ${T_STOP} s"
+[ "$proxy_code" = 0 ] || fail "haproxy exit code $proxy_code after SIGTERM (137: it ignored SIGTERM as PID 1)"
+# Four containers stop side by side on 2 cores: 3 s for all (each one is bounded by the grace).
+awk -v t="$T_STOP" 'BEGIN { exit !(t < 3.0) }' || fail "stopping took ${T_STOP} s (limit 3 s)"
+compose logs --no-color --tail 3 tumble | sed 's/^/    /'
 compose down --timeout 2 >/dev/null 2>&1 || true
 
 awk -v s="$SIZE_MB" -v b="$BUDGET_MB" 'BEGIN { exit !(s <= b) }' \
@@ -281,7 +322,9 @@ printf '  %-28s %s s (%s)\n' "base images" "$T_BASE" "$BASE_HOW"
 printf '  %-28s %s s\n' "dockerd start" "$T_ENGINE"
 printf '  %-28s %s s (%s cores; load average %s before, %s after)\n' \
   "docker build (incl. tests)" "$T_BUILD" "$(nproc)" "$LOAD_BEFORE" "$LOAD_AFTER"
-printf '  %-28s %s s\n' "compose up -> healthy" "$T_HEALTHY"
-printf '  %-28s %s s, exit code %s\n' "SIGTERM -> exited" "$T_STOP" "$code"
+printf '  %-28s %s s, %s MB\n' "haproxy image build" "$T_PROXY_BUILD" "$PROXY_MB"
+printf '  %-28s %s s\n' "up -> $REPLICAS replicas healthy" "$T_HEALTHY"
+printf '  %-28s%s\n' "worlds through HAProxy" "$placement"
+printf '  %-28s %s s, exit codes %s\n' "SIGTERM -> exited" "$T_STOP" "${codes% }"
 printf '  %-28s %s MB (budget %s MB)\n' "runtime image size" "$SIZE_MB" "$BUDGET_MB"
 printf '  %-28s %s s\n' "total" "$(since "$T_START")"

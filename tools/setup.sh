@@ -14,8 +14,10 @@ packages=(build-essential cmake ninja-build pkg-config git ca-certificates
   libboost1.81-dev libboost-program-options1.81-dev libeigen3-dev nlohmann-json3-dev
   zlib1g-dev nodejs)
 if [ "$mode" = all ]; then
+  # haproxy and python3-yaml are for tests only (tests/deploy: the loopback HAProxy test and the
+  # manifest check); Debian's default haproxy.cfg has no listener, so its service binds nothing.
   packages+=(libgtest-dev libgmock-dev libbenchmark-dev chromium gnuplot-nox
-    libbullet-dev libode-dev libmujoco-dev)
+    libbullet-dev libode-dev libmujoco-dev haproxy python3-yaml)
 fi
 missing=()
 for p in "${packages[@]}"; do
