@@ -26,6 +26,8 @@ po::options_description describe() {
       ("web-root", po::value<std::string>()->default_value(default_web_root().string()),
        "directory of the viewer's static files")
       ("threads", po::value<int>()->default_value(2), "I/O threads (1-64)")
+      ("io-nice", po::value<int>()->default_value(5),
+       "nice value of the I/O threads (0-19): on a busy machine they yield to the simulation")
       ("token", po::value<std::string>()->default_value(""),
        "bearer token required on POST requests (empty: none)")
       ("max-viewers", po::value<int>()->default_value(64), "most WebSocket viewers (1-10000)")
@@ -111,6 +113,8 @@ ParsedOptions parse_options(int argc, const char* const argv[]) {
   o.web_root = vm["web-root"].as<std::string>();
   o.threads = vm["threads"].as<int>();
   if (o.threads < 1 || o.threads > 64) return bad("--threads must be in 1..64", d);
+  o.io_nice = vm["io-nice"].as<int>();
+  if (o.io_nice < 0 || o.io_nice > 19) return bad("--io-nice must be in 0..19", d);
   o.token = vm["token"].as<std::string>();
   o.max_viewers = vm["max-viewers"].as<int>();
   if (o.max_viewers < 1 || o.max_viewers > 10000)

@@ -15,6 +15,7 @@ struct ServerOptions {
   int render_ms = 20;                  ///< Interval between WebSocket frames, ms.
   std::filesystem::path web_root;      ///< Directory of the viewer's static files.
   int threads = 2;                     ///< I/O threads (the simulation has its own).
+  int io_nice = 5;                     ///< Nice value of the I/O threads (0..19; 0: as the rest).
   int sim_threads = 0;                 ///< Simulation threads all worlds share (0: the cores).
   int step_threads = 1;                ///< Threads of each physics step (World::set_threads).
   std::string token;                   ///< Bearer token for POSTs; empty: none required.

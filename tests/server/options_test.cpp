@@ -74,8 +74,9 @@ TEST(Options, WorldLimits) {
   EXPECT_EQ(p.options->max_bodies, 10);
   EXPECT_EQ(p.options->idle_s, 0.5);
   EXPECT_EQ(p.options->idle_remove_s, 2.0);
+  EXPECT_EQ(p.options->io_nice, 5) << "the default";
   const std::vector<std::vector<std::string>> bad = {
-      {"--max-worlds", "0"}, {"--max-bodies", "0"}, {"--idle-s", "0"},
+      {"--max-worlds", "0"}, {"--max-bodies", "0"}, {"--idle-s", "0"}, {"--io-nice", "20"},
       {"--idle-s", "10", "--idle-remove-s", "5"}};
   for (const auto& args : bad) {
     std::vector<const char*> argv;
