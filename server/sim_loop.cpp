@@ -5,6 +5,7 @@
 #include <new>
 
 #include "request_limits.hpp"
+#include "sim_pool.hpp"
 
 namespace tumble::server {
 namespace {

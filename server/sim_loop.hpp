@@ -21,11 +21,12 @@
 
 #include "commands.hpp"
 #include "metrics.hpp"
-#include "sim_pool.hpp"
 #include "snapshot.hpp"
 #include "tumble/world.hpp"
 
 namespace tumble::server {
+
+class SimPool;
 
 /// The latest snapshot, handed from the simulation thread (store) to any thread (load).
 /// A mutex held for one shared_ptr copy, not std::atomic<std::shared_ptr>: GCC 12's

@@ -1,4 +1,5 @@
 #include "sim_loop.hpp"
+#include "sim_pool.hpp"
 
 #include <gtest/gtest.h>
 
