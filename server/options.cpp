@@ -44,7 +44,7 @@ po::options_description describe() {
        "Default 1: the cores also serve other worlds and the viewers (docs/engine.md, Threads)")
       ("max-worlds", po::value<int>()->default_value(64),
        "most worlds on this server, the default counted (1-10000); beyond: 429")
-      ("max-bodies", po::value<int>()->default_value(5000),
+      ("max-bodies", po::value<int>()->default_value(10000),
        "most bodies in a scene sent by a client (PUT /api/worlds, reset; 1-100000)")
       ("idle-s", po::value<double>()->default_value(300),
        "pause a world (not the default) with no viewer and no request for this long, s")

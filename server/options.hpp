@@ -27,7 +27,7 @@ struct ServerOptions {
   int viewer_timeout_ms = 15000;       ///< A viewer that answers no ping this long is dropped, ms.
   double read_budget = 20000;          ///< Body records/s per client for /api/state, /api/scene.
   int max_worlds = 64;                 ///< Most worlds, the default counted (PUT beyond: 429).
-  int max_bodies = 5000;               ///< Most bodies in a scene sent over REST (beyond: 400).
+  int max_bodies = 10000;              ///< Most bodies in a scene sent over REST (beyond: 400).
   double idle_s = 300;                 ///< A world with no viewer or request this long pauses, s.
   double idle_remove_s = 3600;         ///< … and is removed after this long, s.
 };

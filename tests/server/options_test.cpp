@@ -1,4 +1,5 @@
 #include "options.hpp"
+#include "tumble/scene_io.hpp"
 
 #include <gtest/gtest.h>
 
@@ -63,6 +64,15 @@ TEST(Options, SimThreads) {
   const ParsedOptions e = parse({});
   ASSERT_TRUE(e.options) << e.message;
   EXPECT_EQ(e.options->sim_threads, 2);
+}
+
+// Every bundled scene fits the default --max-bodies: the viewer's scene menu offers them all.
+TEST(Options, EveryBundledSceneFitsTheDefaultBodyLimit) {
+  const ParsedOptions p = parse({});
+  ASSERT_TRUE(p.options);
+  for (const std::string& name : bundled_scene_names())
+    EXPECT_LE(load_scene(name).bodies.size(), static_cast<std::size_t>(p.options->max_bodies))
+        << name;
 }
 
 // The worlds' limits: each refused outside its range with exit code 2 and its name.
