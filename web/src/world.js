@@ -99,6 +99,19 @@ export function steerLink(id) {
   return url.href;
 }
 
+/**
+ * `href` without the server's own token (`?token=`, which a page of a `--token` server may carry):
+ * a link meant for others must not hand them the server's key. Only a world's token, in the
+ * fragment of a steer link, is meant to travel.
+ */
+export function shareable(href) {
+  if (!href) return href;  // no steer link: nothing to share
+  const url = new URL(href);
+  url.searchParams.delete('token');
+  url.searchParams.delete('access_token');
+  return url.href;
+}
+
 /** A readable random world id such as `plucky-otter-4821` (about 19 bits of chance). */
 export function randomWorldId() {
   const r = new Uint32Array(3);

@@ -1,7 +1,9 @@
 // The panel's World folder: the server's worlds (join one), a new private world from a bundled
 // scene, and the view and steer links of the world shown.
 import { api } from './connection.js';
-import { currentWorld, randomWorldId, steerLink, storeWorldToken, viewLink, worldToken, worldUrl } from './world.js';
+import {
+  currentWorld, randomWorldId, shareable, steerLink, storeWorldToken, viewLink, worldToken, worldUrl,
+} from './world.js';
 
 /** Time between refreshes of the world list while the folder is open, ms. */
 const kRefreshMs = 5000;
@@ -26,8 +28,8 @@ export class WorldMenu {
       join: this.world ?? kDefault,
       template: 'seed',
       create: () => this.createWorld(),
-      view: () => this.#copy('view link', viewLink(this.world)),
-      steer: () => this.#copy('steer link', steerLink(this.world)),
+      view: () => this.#copy('view link', shareable(viewLink(this.world))),
+      steer: () => this.#copy('steer link', shareable(steerLink(this.world))),
     };
     const folder = gui.addFolder('World');
     this.folder = folder;
