@@ -435,8 +435,11 @@ void serve_world_route(const Request& req, ServerContext& ctx, const Target& t,
     return answer(unauthorised(req));
   if (post && !origin_allowed(req, options))
     throw Refusal{403, "requests from this origin are not allowed", "Origin"};
-  world->touch();
-  route.handler(req, ctx, *world, answer);
+  // The world is busy from here until the answer is sent (or the handler throws): the guard
+  // lives in the answer, which the command's completion holds while the simulation runs it.
+  world->begin_request();
+  const std::shared_ptr<void> busy(nullptr, [world](void*) { world->end_request(); });
+  route.handler(req, ctx, *world, [busy, answer](Response res) { answer(std::move(res)); });
 }
 
 void dispatch(const Request& req, ServerContext& ctx, const Reply& answer) {

@@ -55,6 +55,16 @@ void HostedWorld::touch() {
   if (idle_paused_.exchange(false)) sim_.submit({ResumeCommand{}, nullptr});
 }
 
+void HostedWorld::begin_request() {
+  requests_.fetch_add(1, std::memory_order_relaxed);
+  touch();
+}
+
+void HostedWorld::end_request() {
+  last_used_.store(Clock::now().time_since_epoch().count(), std::memory_order_relaxed);
+  requests_.fetch_sub(1, std::memory_order_relaxed);
+}
+
 Clock::duration HostedWorld::idle_for() const {
   const Clock::duration used(last_used_.load(std::memory_order_relaxed));
   return Clock::now() - Clock::time_point(used);
@@ -169,7 +179,7 @@ void WorldRegistry::sweep_idle() {
   const auto remove_after = std::chrono::duration<double>(options_.idle_remove_s);
   for (const auto& world : list()) {
     if (world == default_) continue;
-    if (world->broadcaster().viewers() > 0) {
+    if (world->broadcaster().viewers() > 0 || world->busy()) {
       world->touch();
       continue;
     }

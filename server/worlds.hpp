@@ -58,6 +58,13 @@ class HostedWorld : public std::enable_shared_from_this<HostedWorld> {
 
   /// A request or a viewer used the world now; a world paused for idleness resumes.
   void touch();
+  /// A request addressing the world began (touches it); until its end_request() the world is
+  /// not idle, however long the request runs (a POST /api/step may take --step-budget-ms).
+  void begin_request();
+  /// That request was answered (touches it again).
+  void end_request();
+  /// Requests begun and not yet answered.
+  bool busy() const { return requests_.load(std::memory_order_relaxed) > 0; }
   /// Wall time since it was last used.
   Clock::duration idle_for() const;
   /// Pauses it for idleness (a touch resumes it); false if it was paused already (by idleness
@@ -72,6 +79,7 @@ class HostedWorld : public std::enable_shared_from_this<HostedWorld> {
   Broadcaster broadcaster_;
   std::atomic<Clock::rep> last_used_;
   std::atomic<bool> idle_paused_{false};
+  std::atomic<int> requests_{0};
 };
 
 /// Why a create was refused.

@@ -204,6 +204,29 @@ TEST_F(WorldsTest, ARequestWakesAnIdleWorld) {
   EXPECT_EQ(listed("sleepy")["paused"], false);
 }
 
+// A world whose request is still running is not idle: a POST /api/step that runs past
+// --idle-remove-s (the landing pile under a 2.5 s step budget) keeps its world, and answers.
+class WorldsWithBigScenes : public WorldsTest {
+  void configure(ServerOptions& o) override {
+    WorldsTest::configure(o);
+    o.max_bodies = 2000;
+    o.step_budget_ms = 2500;  // past --idle-remove-s (1.2 s), within the client's 5 s
+  }
+};
+
+TEST_F(WorldsWithBigScenes, ALongRequestKeepsItsWorld) {
+  const std::string token = create("busy", "pile");
+  ASSERT_EQ(post("busy", "pause", token).status, 200u);
+  const auto t0 = std::chrono::steady_clock::now();
+  const HttpReply r = post("busy", "step", token, R"({"steps": 100000})");
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(r.status, 200u) << r.body;
+  EXPECT_GT(r.json()["steps_done"].get<int>(), 0);
+  EXPECT_GT(took, 1.2) << "the step ended before --idle-remove-s: nothing was shown";
+  EXPECT_FALSE(listed("busy").is_null()) << "removed while its step ran";
+  EXPECT_EQ(listed("busy")["paused"], true);
+}
+
 // A world its user paused is not resumed by a later request.
 TEST_F(WorldsTest, AUserPauseOutlastsIdleness) {
   const std::string token = create("held");
