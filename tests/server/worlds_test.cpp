@@ -19,8 +19,8 @@ class WorldsTest : public ServerTest {
   void configure(ServerOptions& o) override {
     o.max_worlds = 4;
     o.max_bodies = 500;
-    o.idle_s = 0.4;
-    o.idle_remove_s = 1.2;
+    o.idle_s = 60;  // far beyond a test, even a sanitizer build's (IdleWorldsTest shortens it)
+    o.idle_remove_s = 120;
   }
 
   /// PUT /api/worlds/{id} with `scene` (JSON text).
@@ -165,9 +165,19 @@ TEST_F(WorldsTest, BadRequestsNameTheField) {
   EXPECT_EQ(http_get(port_, "/api/worlds").json()["worlds"].size(), 1u) << "nothing was created";
 }
 
+// Idleness in test time: paused after 0.4 s, removed after 1.2 s.
+class IdleWorldsTest : public WorldsTest {
+ protected:
+  void configure(ServerOptions& o) override {
+    WorldsTest::configure(o);
+    o.idle_s = 0.4;
+    o.idle_remove_s = 1.2;
+  }
+};
+
 // No viewer and no request for --idle-s: paused; for --idle-remove-s: removed. A viewer keeps
 // a world alive; the default world never idles out.
-TEST_F(WorldsTest, IdleWorldsPauseThenGo) {
+TEST_F(IdleWorldsTest, IdleWorldsPauseThenGo) {
   create("idle");
   create("watched");
   WsClient viewer(port_, {}, "/ws?world=watched");
@@ -193,7 +203,7 @@ TEST_F(WorldsTest, IdleWorldsPauseThenGo) {
 }
 
 // A request to an idle-paused world wakes it.
-TEST_F(WorldsTest, ARequestWakesAnIdleWorld) {
+TEST_F(IdleWorldsTest, ARequestWakesAnIdleWorld) {
   create("sleepy");
   const auto deadline = std::chrono::steady_clock::now() + 3s;
   while (listed("sleepy")["paused"] != true && std::chrono::steady_clock::now() < deadline)
@@ -206,9 +216,9 @@ TEST_F(WorldsTest, ARequestWakesAnIdleWorld) {
 
 // A world whose request is still running is not idle: a POST /api/step that runs past
 // --idle-remove-s (the landing pile under a 2.5 s step budget) keeps its world, and answers.
-class WorldsWithBigScenes : public WorldsTest {
+class WorldsWithBigScenes : public IdleWorldsTest {
   void configure(ServerOptions& o) override {
-    WorldsTest::configure(o);
+    IdleWorldsTest::configure(o);
     o.max_bodies = 2000;
     o.step_budget_ms = 2500;  // past --idle-remove-s (1.2 s), within the client's 5 s
   }
@@ -228,7 +238,7 @@ TEST_F(WorldsWithBigScenes, ALongRequestKeepsItsWorld) {
 }
 
 // A world its user paused is not resumed by a later request.
-TEST_F(WorldsTest, AUserPauseOutlastsIdleness) {
+TEST_F(IdleWorldsTest, AUserPauseOutlastsIdleness) {
   const std::string token = create("held");
   ASSERT_EQ(post("held", "pause", token).status, 200u);
   std::this_thread::sleep_for(700ms);  // past --idle-s
