@@ -7,75 +7,16 @@
 //      TUMBLE_E2E_SHOTS  directory to keep the screenshots in (default: a temp dir, removed)
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath, pathToFileURL } from 'node:url';
+import { pathToFileURL } from 'node:url';
+import {
+  kChromium, kChromiumArgs, kPlaywright, kRepo, kServer, kViewport, sleep, startServer, stopServer, until,
+} from './harness.mjs';
 import { decodePng } from './png.mjs';
 
-const kRepo = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
-const kServer = process.env.TUMBLE_SERVER || path.join(kRepo, 'build/release/server/tumble-server');
-const kPlaywright = path.join(kRepo, 'web/node_modules/playwright-core/index.mjs');
-const kChromium = '/usr/bin/chromium';
-const kChromiumArgs = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--no-first-run', '--enable-unsafe-swiftshader'];
-const kViewport = { width: 720, height: 540 }; // small (SwiftShader pays per pixel), not phone-sized
 const kBoxColor = [0xd9, 0x82, 0x2b]; // the seed scene's box, #d9822b
-
-const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
-
-/** Polls `probe` until it returns a truthy value; fails with `what` after `timeoutMs`. */
-async function until(what, probe, timeoutMs = 15000, everyMs = 150) {
-  const end = Date.now() + timeoutMs;
-  let last;
-  for (;;) {
-    try {
-      last = await probe();
-      if (last) return last;
-    } catch (e) {
-      last = e;
-    }
-    if (Date.now() > end) assert.fail(`timed out after ${timeoutMs} ms waiting for ${what} (last: ${last})`);
-    await sleep(everyMs);
-  }
-}
-
-/** Starts tumble-server; resolves with {child, port} once it prints its URL. */
-function startServer(port, scene = 'seed') {
-  const env = { ...process.env };
-  delete env.TUMBLE_TOKEN; // POSTs from the page carry no token
-  delete env.TUMBLE_PORT;
-  const child = spawn(kServer, ['--port', String(port), '--scene', scene, '--web-root', path.join(kRepo, 'web')],
-    { env, stdio: ['ignore', 'pipe', 'pipe'] });
-  let output = '';
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`server printed no URL in 10 s:\n${output}`)), 10000);
-    const onData = (chunk) => {
-      output += chunk;
-      const match = /Tumble viewer: http:\/\/[^:\s]+:(\d+)\//.exec(output);
-      if (match) {
-        clearTimeout(timer);
-        resolve({ child, port: Number(match[1]) });
-      }
-    };
-    child.stdout.on('data', onData);
-    child.stderr.on('data', onData);
-    child.on('exit', (code) => {
-      clearTimeout(timer);
-      reject(new Error(`server exited with ${code}:\n${output}`));
-    });
-  });
-}
-
-async function stopServer(child) {
-  if (child.exitCode !== null || child.signalCode !== null) return;
-  const exited = new Promise((resolve) => child.once('exit', resolve));
-  child.kill('SIGTERM');
-  const timer = setTimeout(() => child.kill('SIGKILL'), 3000);
-  await exited;
-  clearTimeout(timer);
-}
 
 /** Counts the pixels whose colour is the box's orange under some lighting; returns their centroid. */
 function findBoxPixels(png) {

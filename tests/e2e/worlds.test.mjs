@@ -10,78 +10,19 @@
 //      TUMBLE_E2E_SHOTS  directory to keep the screenshots in (default: a temp dir, removed)
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { fileURLToPath, pathToFileURL } from 'node:url';
+import { pathToFileURL } from 'node:url';
+import {
+  kChromium, kChromiumArgs, kPlaywright, kRepo, kServer, kViewport, sleep, startServer, stopServer, until,
+} from './harness.mjs';
 import { decodePng } from './png.mjs';
 
-const kRepo = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '..', '..');
-const kServer = process.env.TUMBLE_SERVER || path.join(kRepo, 'build/release/server/tumble-server');
-const kPlaywright = path.join(kRepo, 'web/node_modules/playwright-core/index.mjs');
-const kChromium = '/usr/bin/chromium';
-const kChromiumArgs = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--no-first-run', '--enable-unsafe-swiftshader'];
-const kViewport = { width: 720, height: 540 }; // as viewer.test.mjs: SwiftShader pays per pixel
 /** What the HUD says on a 401 (web/src/controls.js, kViewOnlyWorld). */
 const kViewOnly = 'view only: this world belongs to another viewer; open its steer link to control it';
 /** Hides the overlays, so that a screenshot shows the 3D view only (toasts and HUD figures change). */
 const kOverlaysHidden = '.card, #panel, #hint, #toasts, #banner { visibility: hidden !important; }';
-
-const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
-
-/** Polls `probe` until it returns a truthy value; fails with `what` after `timeoutMs`. */
-async function until(what, probe, timeoutMs = 15000, everyMs = 150) {
-  const end = Date.now() + timeoutMs;
-  let last;
-  for (;;) {
-    try {
-      last = await probe();
-      if (last) return last;
-    } catch (e) {
-      last = e;
-    }
-    if (Date.now() > end) assert.fail(`timed out after ${timeoutMs} ms waiting for ${what} (last: ${last})`);
-    await sleep(everyMs);
-  }
-}
-
-/** Starts tumble-server on an ephemeral port; resolves with {child, port} once it prints its URL. */
-function startServer(scene = 'seed') {
-  const env = { ...process.env };
-  delete env.TUMBLE_TOKEN; // the worlds' own tokens are what this test is about
-  delete env.TUMBLE_PORT;
-  const child = spawn(kServer, ['--port', '0', '--scene', scene, '--web-root', path.join(kRepo, 'web')],
-    { env, stdio: ['ignore', 'pipe', 'pipe'] });
-  let output = '';
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`server printed no URL in 10 s:\n${output}`)), 10000);
-    const onData = (chunk) => {
-      output += chunk;
-      const match = /http:\/\/[^:\s]+:(\d+)\//.exec(output);
-      if (match) {
-        clearTimeout(timer);
-        resolve({ child, port: Number(match[1]) });
-      }
-    };
-    child.stdout.on('data', onData);
-    child.stderr.on('data', onData);
-    child.on('exit', (code) => {
-      clearTimeout(timer);
-      reject(new Error(`server exited with ${code}:\n${output}`));
-    });
-  });
-}
-
-async function stopServer(child) {
-  if (child.exitCode !== null || child.signalCode !== null) return;
-  const exited = new Promise((resolve) => child.once('exit', resolve));
-  child.kill('SIGTERM');
-  const timer = setTimeout(() => child.kill('SIGKILL'), 3000);
-  await exited;
-  clearTimeout(timer);
-}
 
 /** A REST call: {status, body}. `token` goes as a bearer token. */
 async function call(base, method, route, { body, token } = {}) {
@@ -137,7 +78,7 @@ test('two worlds: a kick in one leaves the other still; a page without the token
     const userData = fs.mkdtempSync(path.join(os.tmpdir(), 'tumble-e2e-chromium-'));
     const shots = process.env.TUMBLE_E2E_SHOTS || fs.mkdtempSync(path.join(os.tmpdir(), 'tumble-e2e-shots-'));
     fs.mkdirSync(shots, { recursive: true });
-    const server = await startServer('seed');
+    const server = await startServer(0, 'seed');
     const base = `http://127.0.0.1:${server.port}/`;
     let context;
     t.after(async () => {
