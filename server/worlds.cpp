@@ -128,21 +128,26 @@ CreateResult WorldRegistry::create(const std::string& id, const std::string& sce
     }
     if (stopped_ || worlds_.size() >= max_worlds_) return {nullptr, false, CreateRefusal::too_many};
   }
-  // Built outside the lock (a 1,000-body scene takes milliseconds), then placed under it;
-  // a create of the same id that won the race meanwhile decides the answer.
+  // Built and started outside the lock (a 1,000-body scene takes milliseconds) and before any
+  // other thread can find it, then placed under the lock; a create of the same id that won the
+  // race meanwhile decides the answer, and this one is shut down again.
   auto world = std::make_shared<HostedWorld>(id, new_world_token(), scene_key, std::move(scene),
                                              ioc_, metrics_, options_);
+  world->start(pool_);
+  CreateResult result{world, true};
   {
     std::lock_guard lock(mutex_);
-    if (const auto it = worlds_.find(id); it != worlds_.end()) {
-      if (it->second->scene_key() == scene_key) return {it->second, false};
-      return {nullptr, false, CreateRefusal::conflict};
-    }
-    if (stopped_ || worlds_.size() >= max_worlds_) return {nullptr, false, CreateRefusal::too_many};
-    worlds_.emplace(id, world);
+    if (const auto it = worlds_.find(id); it != worlds_.end())
+      result = it->second->scene_key() == scene_key
+                   ? CreateResult{it->second, false}
+                   : CreateResult{nullptr, false, CreateRefusal::conflict};
+    else if (stopped_ || worlds_.size() >= max_worlds_)
+      result = {nullptr, false, CreateRefusal::too_many};
+    else
+      worlds_.emplace(id, world);
   }
-  world->start(pool_);
-  return {world, true};
+  if (result.world != world) world->shutdown();
+  return result;
 }
 
 bool WorldRegistry::remove(std::string_view id) {
