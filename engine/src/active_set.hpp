@@ -64,36 +64,52 @@ inline NormalSystem make_normal_system(const Vec3& n, const Vec3& t1, const Vec3
 }
 
 /// P with K⁺ = D P Dᵀ for K = D S Dᵀ (S symmetric positive definite): closed form when the
-/// points span the plane, else through the 3×3 eigendecomposition of G = DᵀD, dropping
-/// directions whose eigenvalue is below 1e-12 of the largest (collinear or coincident points).
+/// points span the plane, else through the eigendecomposition of D's Gram matrix G = DᵀD with
+/// its columns scaled to unit length, dropping directions below 1e-6 of the largest.
+//
+// Both tests are scale-free: det G / (G₀₀ G₁₁ G₂₂) is the Gram determinant of D's normalised
+// columns (1 for orthogonal columns, 0 for collinear points), and the eigenvalues are those of
+// the same normalised matrix, so neither depends on the unit of length or the size of the
+// box. The bound 1e-6 treats points within about 1e-3 of the patch's size of one line as on
+// it. A looser bound (1e-10, which this replaced) let three points 40 µm off one edge of a
+// 1 m face pass as spanning the plane; the inverse of that nearly singular G then gave
+// impulses of 1,500 N·s to a 1 kg box.
 inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
-  Mat3 P;  // K⁺ = D P Dᵀ
+  constexpr double kRank = 1e-6;
   const double det = G.determinant();
-  if (det > 1e-10 * G(0, 0) * G(1, 1) * G(2, 2)) {
+  if (det > kRank * G(0, 0) * G(1, 1) * G(2, 2)) {
     const Mat3 Gi = G.inverse();
-    P = Gi * S.inverse() * Gi;
-  } else {
-    Eigen::SelfAdjointEigenSolver<Mat3> eig(G);
-    const Vec3 lambda = eig.eigenvalues();
-    const double cutoff = 1e-12 * lambda.cwiseAbs().maxCoeff();
-    // Keep the directions D spans: W = V_r Λ_r⁻¹, then P = W (V_rᵀ S V_r)⁻¹ Wᵀ.
-    using Basis = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
-    Basis V(3, 3), W(3, 3);
-    int r = 0;
-    for (int k = 0; k < 3; ++k) {
-      if (lambda(k) <= cutoff) continue;
-      V.col(r) = eig.eigenvectors().col(k);
-      W.col(r) = eig.eigenvectors().col(k) / lambda(k);
-      ++r;
-    }
-    if (r == 0) return Mat3::Zero();
-    V.conservativeResize(3, r);
-    W.conservativeResize(3, r);
-    const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> T =
-        V.transpose() * S * V;
-    P = W * T.inverse() * W.transpose();
+    return Gi * S.inverse() * Gi;
   }
-  return P;
+  // D = D̂ N⁻¹ with D̂'s columns of unit length (N = diag(1/√Gₖₖ); a zero column stays zero),
+  // so K = D̂ Ŝ D̂ᵀ with Ŝ = N⁻¹ S N⁻¹, and P = N P̂ N.
+  Vec3 norm, inv_norm;
+  for (int k = 0; k < 3; ++k) {
+    norm(k) = std::sqrt(G(k, k));
+    inv_norm(k) = norm(k) > 0.0 ? 1.0 / norm(k) : 0.0;
+  }
+  const Mat3 Gn = inv_norm.asDiagonal() * G * inv_norm.asDiagonal();
+  const Mat3 Sn = norm.asDiagonal() * S * norm.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Mat3> eig(Gn);
+  const Vec3 lambda = eig.eigenvalues();
+  const double cutoff = kRank * lambda.cwiseAbs().maxCoeff();
+  // Keep the directions D̂ spans: W = V_r Λ_r⁻¹, then P̂ = W (V_rᵀ Ŝ V_r)⁻¹ Wᵀ.
+  using Basis = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
+  Basis V(3, 3), W(3, 3);
+  int r = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (lambda(k) <= cutoff) continue;
+    V.col(r) = eig.eigenvectors().col(k);
+    W.col(r) = eig.eigenvectors().col(k) / lambda(k);
+    ++r;
+  }
+  if (r == 0) return Mat3::Zero();
+  V.conservativeResize(3, r);
+  W.conservativeResize(3, r);
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> T =
+      V.transpose() * Sn * V;
+  const Mat3 Pn = W * T.inverse() * W.transpose();
+  return inv_norm.asDiagonal() * Pn * inv_norm.asDiagonal();
 }
 
 /// G = Σ dᵢ dᵢᵀ over the rows listed in idx[0..m).
@@ -118,6 +134,8 @@ inline Mat3 pseudo_inverse_factor(const PlaneCoordinates& D, const Mat3& S) {
 class ActiveSetCache {
  public:
   explicit ActiveSetCache(const NormalSystem& system) : system_(system) {}
+  /// It keeps a reference: a temporary system would dangle.
+  explicit ActiveSetCache(NormalSystem&&) = delete;
   /// The system solved.
   const NormalSystem& system() const { return system_; }
   /// P with (K restricted to the points in `mask`)⁺ = D_a P D_aᵀ; the points are idx[0..m).

@@ -102,6 +102,7 @@ struct SolverScratch {
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
   std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
   std::vector<std::uint32_t> waves, wave_of, wave_start, wave_order;  ///< Its waves.
+  std::vector<std::uint32_t> group_start;  ///< Its solves: each body's supports in `order`.
   std::vector<std::int32_t> colour_a, colour_b;  ///< Solver index of each contact's bodies.
   ContactColours colours;                        ///< The contacts grouped by colour.
 };

@@ -202,6 +202,35 @@ TEST(Stack, PyramidOfTwoHundredTenFallsAsleepStanding) {
             << " s, largest displacement " << drift << " m\n";
 }
 
+// Shock propagation solves a box's supports together. One after the other, each pushed the
+// box up at one side and tipped it, the next pushed the other side up further, and the box
+// left faster than its supports: up the 100 rows of pyramid_large the tops of the first step
+// flew up at 0.7 m/s.
+TEST(Stack, ShockPropagationThrowsNothingUpATallPyramid) {
+  World world(load_scene("pyramid_large"));
+  ASSERT_EQ(world.bodies().size(), 5050u);
+  for (int i = 0; i < 3; ++i) {
+    world.step();
+    double fastest_up = 0.0;
+    for (const Body& b : world.bodies()) fastest_up = std::max(fastest_up, b.s.P.y() / b.c.mass);
+    EXPECT_LT(fastest_up, 0.01) << "step " << i + 1;
+  }
+}
+
+// The pyramid kept awake (a zero impulse on every box every 15 steps, as the contact benchmark
+// does): merged support patches once met three points within µm of one line, whose nearly
+// singular system the old rank bound (1e-10) inverted; a box was thrown 0.4 m.
+TEST(Stack, PyramidKeptAwakeStaysPut) {
+  World world(load_scene("pyramid"));
+  const std::vector<Vec3> start = positions(world);
+  for (int i = 0; i < 46; ++i) {
+    if (i % 15 == 0)
+      for (BodyId id = 0; id < world.bodies().size(); ++id) world.apply_impulse(id, Vec3::Zero());
+    world.step();
+  }
+  EXPECT_LE(largest_displacement(world, start), 0.02);
+}
+
 TEST(Stack, HeavyOnLightHolds) {
   World world(load_scene("heavy_on_light"));
   ASSERT_NEAR(world.body(1).c.mass / world.body(0).c.mass, 100.0, 1e-12);
