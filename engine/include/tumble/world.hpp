@@ -108,6 +108,9 @@ class World {
   std::size_t frozen_count() const;
 
  private:
+  /// Builds the broad phase's cache (boxes of the sleeping bodies, sweep order).
+  void prime_broad_phase();
+
   Scene scene_;
   std::vector<Body> bodies_;
   double time_ = 0.0;
