@@ -19,6 +19,8 @@ bool valid_color(const std::string& c) {
   return true;
 }
 
+}  // namespace
+
 std::optional<SceneError> validate_body(const BodyDef& b, const std::string& at) {
   auto err = [&](const char* field, std::string msg) {
     return SceneError{at + "." + field, std::move(msg)};
@@ -44,8 +46,6 @@ std::optional<SceneError> validate_body(const BodyDef& b, const std::string& at)
   if (!valid_color(b.color)) return err("color", "must be \"#rrggbb\"");
   return std::nullopt;
 }
-
-}  // namespace
 
 std::string_view to_string(Integrator i) { return kIntegratorNames[static_cast<int>(i)]; }
 std::string_view to_string(ToiMethod m) { return kToiNames[static_cast<int>(m)]; }

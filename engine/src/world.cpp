@@ -115,6 +115,27 @@ void World::step(double dt) {
   ++steps_;
 }
 
+BodyId World::add_body(const BodyDef& def) {
+  const std::string at = "bodies[" + std::to_string(bodies_.size()) + "]";
+  if (bodies_.size() >= kMaxBodies)
+    throw InvalidInput("bodies: at most " + std::to_string(kMaxBodies) + " bodies");
+  if (auto error = validate_body(def, at)) throw InvalidInput(error->field + ": " + error->message);
+  BodyId existing = 0;
+  if (find_body(def.name, existing))
+    throw InvalidInput(at + ".name: duplicate body name \"" + def.name + "\"");
+  const WorldDef& w = scene_.world;
+  Body b;
+  b.c = make_body_constants(def, w.floor ? w.floor->restitution : 1.0,
+                            w.floor ? w.floor->friction : 0.0);
+  b.s = make_body_state(def, b.c);
+  const auto id = static_cast<BodyId>(bodies_.size());
+  bodies_.push_back(b);
+  scene_.bodies.push_back(def);
+  cache_->sleep_next.push_back(id);  // an island of its own
+  ++cache_->activity_epoch;          // the broad phase sees a new body: it rescans
+  return id;
+}
+
 void World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3& point) {
   require_finite(impulse, "impulse");
   require_finite(point, "point");

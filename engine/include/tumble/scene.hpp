@@ -76,4 +76,7 @@ struct SceneError {
 /// Checks physical validity (positive mass and size, finite values, e ∈ [0,1] …).
 std::optional<SceneError> validate(const Scene& scene);
 
+/// Checks one body as validate does; its fields are named under `at` ("bodies[3]").
+std::optional<SceneError> validate_body(const BodyDef& body, const std::string& at);
+
 }  // namespace tumble

@@ -39,6 +39,20 @@ struct InvalidInput : std::invalid_argument {
 };
 
 /// A simulated world. Deterministic: the same scene and calls give bit-identical states.
+/// Stands for the floor in ContactView::a.
+inline constexpr std::uint32_t kFloorBody = 0xFFFFFFFFu;
+
+/// One contact point as the last step left it, for viewers and tools.
+struct ContactView {
+  Vec3 position = Vec3::Zero();  ///< World, m.
+  Vec3 normal = Vec3::UnitY();   ///< Unit, world, from body a (or the floor) to body b.
+  double impulse = 0.0;  ///< Normal impulse over the last step, N·s (≥ 0); see `solved`.
+  std::uint32_t a = kFloorBody;  ///< Body index, or kFloorBody.
+  std::uint32_t b = 0;           ///< Body index.
+  bool solved = true;  ///< From the contact solver; false: a body resting alone on the floor,
+                       ///< whose impulse is its weight's share m|g|dt / (its touching points).
+};
+
 class World {
  public:
   /// Builds the world; throws InvalidInput with the field when validate(scene) fails.
@@ -106,6 +120,15 @@ class World {
   std::size_t awake_count() const;
   /// Bodies frozen after going non-finite.
   std::size_t frozen_count() const;
+  /// The contact points of the last step (cleared first): the solved contacts of touching
+  /// bodies (points within 0.1 mm or pushing), then the floor points of every other body that
+  /// touches the floor (within 1e-6 m). O(bodies); allocates only to grow `out`.
+  void contacts(std::vector<ContactView>& out) const;
+  /// Adds a body (awake) to the running world and returns its id (the next index); time, steps
+  /// and every other body's state are kept, and the same additions give the same results.
+  /// Throws InvalidInput naming the field ("bodies[12].mass: …") for an invalid or duplicate
+  /// definition, or past kMaxBodies.
+  BodyId add_body(const BodyDef& def);
 
  private:
   /// Builds the broad phase's cache (boxes of the sleeping bodies, sweep order).
