@@ -3,6 +3,7 @@
 // class alone first (bit-for-bit against a straight run of the engine), then through a real
 // server on 127.0.0.1.
 #include <gtest/gtest.h>
+#include <malloc.h>
 
 #include <bit>
 #include <cstring>
@@ -141,6 +142,20 @@ TEST(Timeline, DiscardFutureForgetsLaterCommands) {
   EXPECT_EQ(timeline.head().step, 50u);
   for (const LoggedCommand& c : timeline.summary().commands) EXPECT_LE(c.step, 50u);
   EXPECT_FALSE(timeline.restore(51));
+}
+
+// The byte bound is only as good as the estimate of a World copy: compared here with what
+// the heap grows by when the pile (1000 boxes, landing: the most contacts) is copied.
+TEST(Timeline, CheckpointEstimateCoversTheHeapACopyTakes) {
+  World world(load_scene("pile"));
+  for (int i = 0; i < 150; ++i) world.step();
+  const std::size_t estimate = estimate_world_bytes(world);
+  const std::size_t before = mallinfo2().uordblks;
+  std::optional<World> copy(world);
+  const std::size_t taken = mallinfo2().uordblks - before;
+  std::printf("pile at step 150: a copy takes %zu bytes, estimated %zu\n", taken, estimate);
+  EXPECT_GE(estimate, taken);
+  EXPECT_LE(estimate, 3 * taken) << "an estimate far above the truth wastes the bound";
 }
 
 // ---- Through the server ---------------------------------------------------------------
