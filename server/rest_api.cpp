@@ -313,7 +313,8 @@ void get_metrics(const Request& req, ServerContext& ctx, const Reply& reply) {
   for (const auto& world : ctx.worlds.list()) {
     const auto snap = world->sim().latest();
     gauges.push_back({world->id(), snap->real_time_factor, snap->time, snap->bodies->size(),
-                      snap->awake, world->broadcaster().viewers(), snap->paused});
+                      snap->awake, world->broadcaster().viewers(), snap->paused,
+                      snap->history_bytes});
   }
   Response res{http::status::ok, req.version()};
   res.set(http::field::content_type, "text/plain; version=0.0.4; charset=utf-8");

@@ -188,6 +188,7 @@ void SimLoop::publish(Change change) {
   s->speed = speed_;
   s->live = !at_past();
   s->playing = playing_;
+  s->history_bytes = timeline_.bytes();
   s->real_time_factor = paused_ ? 0.0 : real_time_factor_;
   s->energy = world_->total_energy();
   s->integrator = world_->settings().integrator;

@@ -46,6 +46,7 @@ struct Snapshot {
   double speed = 1.0;                                   ///< Sim s per wall s aimed at.
   bool live = true;                                     ///< At the timeline's newest step.
   bool playing = false;                                 ///< Replaying the recorded future.
+  std::size_t history_bytes = 0;                        ///< Estimated bytes of the timeline.
   double real_time_factor = 0.0;                        ///< Sim s per wall s (0 paused).
   double energy = 0.0;                                  ///< Total energy, J.
   Integrator integrator = Integrator::midpoint;         ///< In use now.
