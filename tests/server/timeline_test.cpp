@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <thread>
 
 #include "child_process.hpp"
@@ -396,6 +397,32 @@ TEST_F(TimelineServerTest, BadInputIsRefusedNamingTheField) {
   // The world is untouched and still answers.
   EXPECT_EQ(get("default", "state")["step"], 30);
   EXPECT_EQ(ok("default", "seek", R"({"step": 10})")["step"], 10);
+}
+
+TEST_F(TimelineServerTest, TheStreamStatusSaysLivePlayingAndSpeed) {
+  fresh("default");
+  step("default", 120);
+  WsClient viewer(port_);
+  const auto status_where = [&](const std::function<bool(const json&)>& wanted) {
+    for (int i = 0; i < 400; ++i) {
+      const std::optional<WsClient::Message> m = viewer.read(3s);
+      if (!m) return json();
+      if (!m->text) continue;
+      const json j = json::parse(m->data);
+      if (j["type"] == "status" && wanted(j)) return j;
+    }
+    return json();
+  };
+  EXPECT_TRUE(status_where([](const json& j) { return j["live"] == true; }).is_object());
+  ok("default", "seek", R"({"step": 40})");
+  const json past = status_where([](const json& j) { return j["live"] == false; });
+  ASSERT_TRUE(past.is_object()) << "no status with live false after a seek";
+  EXPECT_EQ(past["step"], 40);
+  EXPECT_FALSE(past["playing"]);
+  ok("default", "play", R"({"speed": 0.5})");
+  const json playing = status_where([](const json& j) { return j["playing"] == true; });
+  ASSERT_TRUE(playing.is_object());
+  EXPECT_EQ(playing["speed"], 0.5);
 }
 
 class HistoryOffTest : public TimelineServerTest {
