@@ -114,7 +114,8 @@ void Broadcaster::publish(Clock::time_point now) {
 std::shared_ptr<const nlohmann::json> Broadcaster::status_if_due(const Snapshot& snap,
                                                                  const FrameState& state) {
   const std::string key = std::to_string(snap.scene->generation) + (snap.paused ? "p" : "r") +
-                          std::string(to_string(snap.integrator));
+                          (snap.live ? "l" : snap.playing ? "y" : "h") +
+                          std::to_string(snap.speed) + std::string(to_string(snap.integrator));
   if (key == status_key_ && state.number - status_frame_ < kStatusEvery) return nullptr;
   status_key_ = key;
   status_frame_ = state.number;
@@ -125,6 +126,9 @@ std::shared_ptr<const nlohmann::json> Broadcaster::status_if_due(const Snapshot&
       {"time", snap.time},
       {"step", snap.step},
       {"paused", snap.paused},
+      {"live", snap.live},
+      {"playing", snap.playing},
+      {"speed", snap.speed},
       {"real_time_factor", snap.real_time_factor},
       {"integrator", std::string(to_string(snap.integrator))},
       {"bodies", n},

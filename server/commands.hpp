@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -12,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "recording.hpp"
+#include "timeline.hpp"
 #include "tumble/scene.hpp"
 #include "tumble/world.hpp"
 
@@ -56,9 +59,39 @@ struct StepReport {
   const char* stopped = nullptr;  ///< "budget", "cancelled", "shutdown", "out of memory".
 };
 
+/// A seek done: the world shows this step, paused.
+struct SeekDone {
+  double time = 0.0;       ///< Its sim time, s.
+  std::uint64_t step = 0;  ///< The step.
+};
+/// Play or speed done: how the loop runs now.
+struct PlayState {
+  double time = 0.0;       ///< Sim time now, s.
+  std::uint64_t step = 0;  ///< Step now.
+  bool playing = false;    ///< Replaying the recorded future (not live).
+  bool paused = false;     ///< Paused.
+  double speed = 1.0;      ///< Sim seconds per wall second aimed at.
+};
+/// GET …/history: the timeline and where the world is in it.
+struct HistoryReport {
+  TimelineSummary timeline;      ///< Range, lists, bytes.
+  TimelinePoint at;              ///< The step the world shows.
+  bool live = true;              ///< At the newest recorded step.
+  bool playing = false;          ///< Replaying the recorded future.
+  bool paused = false;           ///< Paused.
+  double speed = 1.0;            ///< Sim seconds per wall second aimed at.
+  std::size_t bytes_limit = 0;   ///< --history-mb in bytes.
+  double history_s = 0.0;        ///< --history-s.
+};
+/// GET …/recording: the run from step 0 to the step shown.
+struct RecordingReport {
+  std::shared_ptr<const Recording> recording;  ///< Never null.
+};
+
 /// What a command did, as data: the simulation thread knows nothing of HTTP.
 using CommandOutcome =
-    std::variant<CommandError, PausedState, SceneReset, IntegratorSet, ImpulseApplied, StepReport>;
+    std::variant<CommandError, PausedState, SceneReset, IntegratorSet, ImpulseApplied, StepReport,
+                 SeekDone, PlayState, HistoryReport, RecordingReport>;
 
 /// Builds a CommandError outcome.
 CommandOutcome command_error(Failure failure, std::string message, std::string field);
@@ -86,9 +119,30 @@ struct SetIntegratorCommand {
   Integrator integrator = Integrator::midpoint;
 };
 
+/// Show the world at a recorded step (by step, or the step nearest a sim time in s), paused.
+struct SeekCommand {
+  std::optional<std::uint64_t> step;  ///< Exactly one of step and time is set.
+  std::optional<double> time;
+};
+/// From a past step: replay the recorded future at `speed`× real time, then go on live at 1×;
+/// at the newest step: resume live at `speed`×.
+struct PlayCommand {
+  double speed = 1.0;
+};
+/// The real-time factor to aim at (slow motion below 1).
+struct SpeedCommand {
+  double speed = 1.0;
+};
+/// Report the timeline (a read: changes nothing).
+struct HistoryCommand {};
+/// Build the recording of the run up to the step shown (a read: changes nothing).
+struct RecordingCommand {};
+
 /// What a command asks for.
-using CommandKind = std::variant<ResetCommand, PauseCommand, ResumeCommand, StepCommand,
-                                 ImpulseCommand, SetIntegratorCommand>;
+using CommandKind =
+    std::variant<ResetCommand, PauseCommand, ResumeCommand, StepCommand, ImpulseCommand,
+                 SetIntegratorCommand, SeekCommand, PlayCommand, SpeedCommand, HistoryCommand,
+                 RecordingCommand>;
 
 /// Called once with the outcome, on the simulation thread: must be cheap and must not throw
 /// (post the work to the caller's executor).

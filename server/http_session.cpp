@@ -94,7 +94,7 @@ bool costly_read(const Request& req) {
   if (req.method() != http::verb::get && req.method() != http::verb::head) return false;
   const std::string_view target = req.target();
   const std::string_view path = target.substr(0, target.find_first_of("?#"));
-  return path.ends_with("/state") || path.ends_with("/scene");
+  return path.ends_with("/state") || path.ends_with("/scene") || path.ends_with("/recording");
 }
 
 }  // namespace

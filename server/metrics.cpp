@@ -49,6 +49,9 @@ std::string render_world_gauges(const std::vector<WorldGauges>& worlds) {
          [](const WorldGauges& w) { return w.viewers; });
   family("tumble_world_paused", "1 while the world is paused.",
          [](const WorldGauges& w) { return w.paused ? 1 : 0; });
+  family("tumble_world_history_bytes",
+         "Estimated bytes of the world's timeline (checkpoints, log), at most --history-mb.",
+         [](const WorldGauges& w) { return w.history_bytes; });
   return out.str();
 }
 

@@ -20,6 +20,7 @@ struct WorldGauges {
   std::size_t awake = 0;         ///< Bodies awake.
   std::size_t viewers = 0;       ///< WebSocket viewers.
   bool paused = false;           ///< Paused.
+  std::size_t history_bytes = 0; ///< Estimated bytes of its timeline.
 };
 
 /// The per-world gauges (label world="id") and tumble_worlds, Prometheus text.

@@ -50,6 +50,10 @@ po::options_description describe() {
        "pause a world (not the default) with no viewer and no request for this long, s")
       ("idle-remove-s", po::value<double>()->default_value(3600),
        "remove such a world after this long idle, s (at least --idle-s)")
+      ("history-s", po::value<double>()->default_value(60),
+       "sim seconds of history (seek, replay) each world keeps (0: none; at most 86400)")
+      ("history-mb", po::value<int>()->default_value(64),
+       "most MiB of history per world (1-65536): checkpoints are thinned, then dropped, to fit")
       ("step-budget-ms", po::value<int>()->default_value(5000),
        "wall-time budget of one POST /api/step, ms (10-600000)")
       ("viewer-timeout-ms", po::value<int>()->default_value(15000),
@@ -140,6 +144,11 @@ ParsedOptions parse_options(int argc, const char* const argv[]) {
   o.idle_remove_s = vm["idle-remove-s"].as<double>();
   if (!(o.idle_remove_s >= o.idle_s && o.idle_remove_s <= 1e8))
     return bad("--idle-remove-s must be at least --idle-s and at most 1e8", d);
+  o.history_s = vm["history-s"].as<double>();
+  if (!(o.history_s >= 0.0 && o.history_s <= 86400))
+    return bad("--history-s must be in 0..86400", d);
+  o.history_mb = vm["history-mb"].as<int>();
+  if (o.history_mb < 1 || o.history_mb > 65536) return bad("--history-mb must be in 1..65536", d);
   o.step_budget_ms = vm["step-budget-ms"].as<int>();
   if (o.step_budget_ms < 10 || o.step_budget_ms > 600000)
     return bad("--step-budget-ms must be in 10..600000", d);

@@ -30,6 +30,8 @@ struct ServerOptions {
   int max_bodies = 10000;              ///< Most bodies in a scene sent over REST (beyond: 400).
   double idle_s = 300;                 ///< A world with no viewer or request this long pauses, s.
   double idle_remove_s = 3600;         ///< … and is removed after this long, s.
+  double history_s = 60;               ///< Sim seconds of timeline kept per world (0: none).
+  int history_mb = 64;                 ///< Most MiB of timeline per world (checkpoints, log).
 };
 
 /// Result of parsing: options, or an exit code with the text to print.

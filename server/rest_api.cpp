@@ -5,6 +5,8 @@
 #include <initializer_list>
 
 #include "request_limits.hpp"
+#include "sim_loop.hpp"
+#include "timeline_json.hpp"
 #include "tumble/scene_io.hpp"
 #include "worlds.hpp"
 
@@ -230,6 +232,64 @@ void post_integrator(const Request& req, ServerContext&, HostedWorld& world,
   submit(world, req, SetIntegratorCommand{*i}, reply);
 }
 
+// ---- Timeline (docs/protocol.md, "Timeline") -------------------------------------------
+
+double speed_field(const json& body, double lo, double hi, bool optional) {
+  if (!body.contains("speed")) {
+    if (optional) return 1.0;
+    throw Refusal{400, "missing field 'speed'", "speed"};
+  }
+  const json& speed = body["speed"];
+  if (!speed.is_number()) throw Refusal{400, "speed must be a number", "speed"};
+  const double f = speed.get<double>();
+  if (!(f >= lo && f <= hi))
+    throw Refusal{400, "speed must be in " + json(lo).dump() + ".." + json(hi).dump(), "speed"};
+  return f;
+}
+
+void post_seek(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  const json body = parse_body(req);
+  only_keys(body, {"time", "step"});
+  SeekCommand c;
+  if (body.contains("time") == body.contains("step"))
+    throw Refusal{400, "give exactly one of 'time' (s) and 'step'",
+                  body.contains("time") ? "step" : "time"};
+  if (body.contains("time")) {
+    if (!body["time"].is_number()) throw Refusal{400, "time must be a number", "time"};
+    c.time = body["time"].get<double>();
+  } else {
+    const json& step = body["step"];
+    if (!step.is_number_integer() || (!step.is_number_unsigned() && step.get<std::int64_t>() < 0))
+      throw Refusal{400, "step must be a non-negative integer", "step"};
+    c.step = step.get<std::uint64_t>();
+  }
+  submit(world, req, c, reply);
+}
+
+void post_play(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  const json body = parse_body(req);
+  only_keys(body, {"speed"});
+  submit(world, req,
+         PlayCommand{speed_field(body, SimLoop::kMinPlaySpeed, SimLoop::kMaxPlaySpeed, true)},
+         reply);
+}
+
+void post_speed(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  const json body = parse_body(req);
+  only_keys(body, {"speed"});
+  submit(world, req,
+         SpeedCommand{speed_field(body, SimLoop::kMinLiveSpeed, SimLoop::kMaxLiveSpeed, false)},
+         reply);
+}
+
+void get_history(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  submit(world, req, HistoryCommand{}, reply);
+}
+
+void get_recording(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
+  submit(world, req, RecordingCommand{}, reply);
+}
+
 // ---- Reads from the latest snapshot ----------------------------------------------------
 
 void get_health(const Request& req, ServerContext&, const Reply& reply) {
@@ -253,7 +313,8 @@ void get_metrics(const Request& req, ServerContext& ctx, const Reply& reply) {
   for (const auto& world : ctx.worlds.list()) {
     const auto snap = world->sim().latest();
     gauges.push_back({world->id(), snap->real_time_factor, snap->time, snap->bodies->size(),
-                      snap->awake, world->broadcaster().viewers(), snap->paused});
+                      snap->awake, world->broadcaster().viewers(), snap->paused,
+                      snap->history_bytes});
   }
   Response res{http::status::ok, req.version()};
   res.set(http::field::content_type, "text/plain; version=0.0.4; charset=utf-8");
@@ -335,6 +396,11 @@ constexpr WorldRoute kWorldRoutes[] = {
     {"/api/step", http::verb::post, post_step},
     {"/api/impulse", http::verb::post, post_impulse},
     {"/api/integrator", http::verb::post, post_integrator},
+    {"/api/history", http::verb::get, get_history},
+    {"/api/recording", http::verb::get, get_recording},
+    {"/api/seek", http::verb::post, post_seek},
+    {"/api/play", http::verb::post, post_play},
+    {"/api/speed", http::verb::post, post_speed},
 };
 
 /// Routes of the server as a whole.
@@ -577,6 +643,10 @@ json outcome_json(const CommandOutcome& outcome) {
       if (r.stopped) body["stopped"] = r.stopped;
       return body;
     }
+    json operator()(const SeekDone& d) const { return seek_json(d); }
+    json operator()(const PlayState& p) const { return play_json(p); }
+    json operator()(const HistoryReport& h) const { return history_json(h); }
+    json operator()(const RecordingReport& r) const { return recording_json(*r.recording); }
   };
   return std::visit(Visitor{}, outcome);
 }

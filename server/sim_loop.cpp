@@ -32,11 +32,13 @@ void complete(Command& command, CommandOutcome result) {
 }  // namespace
 
 SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_command_budget,
-                 unsigned step_threads)
+                 unsigned step_threads, TimelineLimits timeline)
     : metrics_(metrics),
       world_(std::make_unique<World>(std::move(scene))),
+      timeline_(timeline),
       step_command_budget_(step_command_budget) {
   world_->set_threads(step_threads);
+  timeline_.restart(*world_, world_->scene().world.name);
   new_scene_info();
   anchor(Clock::now());
   publish(Change::restart);
@@ -78,7 +80,7 @@ Clock::time_point SimLoop::service() {
   }
   // Due when the wall clock reaches the sim time just computed.
   return anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
-                            std::chrono::duration<double>(world_->time() - anchor_sim_));
+                            std::chrono::duration<double>((world_->time() - anchor_sim_) / speed_));
 }
 
 // An allocation failure inside a step leaves the world as that step left it (World::step is
@@ -99,6 +101,30 @@ void SimLoop::on_step_failure(const std::exception& e) {
 void SimLoop::world_step() {
   if (before_step_) before_step_();
   world_->step();
+  after_step();
+}
+
+bool SimLoop::at_past() const {
+  return timeline_.enabled() && world_->step_count() < timeline_.head().step;
+}
+
+// A step at a past step replays the recorded future (its logged commands apply at their
+// steps); reaching the newest recorded step, a playback goes on live at 1×. A step beyond it
+// is recorded.
+void SimLoop::after_step() {
+  if (!timeline_.enabled() || world_->step_count() > timeline_.head().step)
+    return timeline_.record_step(*world_);
+  timeline_.apply_logged_at(*world_);
+  if (world_->step_count() == timeline_.head().step && playing_) {
+    playing_ = false;
+    speed_ = 1.0;
+    anchor(Clock::now());
+  }
+}
+
+// A command that changes the world at a past step discards the recorded future first.
+void SimLoop::log_command(LoggedCommand command) {
+  timeline_.record_command(*world_, std::move(command));
 }
 
 void SimLoop::anchor(Clock::time_point now) {
@@ -108,7 +134,7 @@ void SimLoop::anchor(Clock::time_point now) {
 }
 
 double SimLoop::sim_clock(Clock::time_point now) const {
-  return anchor_sim_ + seconds(now - anchor_wall_);
+  return anchor_sim_ + speed_ * seconds(now - anchor_wall_);
 }
 
 // Fixed-step real-time loop (the accumulator is sim_clock(now) − world time): steps are
@@ -159,6 +185,10 @@ void SimLoop::publish(Change change) {
   s->time = world_->time();
   s->step = world_->step_count();
   s->paused = paused_;
+  s->speed = speed_;
+  s->live = !at_past();
+  s->playing = playing_;
+  s->history_bytes = timeline_.bytes();
   s->real_time_factor = paused_ ? 0.0 : real_time_factor_;
   s->energy = world_->total_energy();
   s->integrator = world_->settings().integrator;
@@ -174,7 +204,7 @@ void SimLoop::publish(Change change) {
     s->previous_time = last->previous_time;
   }
   s->wall_time = anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(s->time - anchor_sim_));
+                                    std::chrono::duration<double>((s->time - anchor_sim_) / speed_));
   latest_.store(std::move(s));
 }
 
@@ -184,10 +214,13 @@ void SimLoop::execute(Command& command) {
     if (is_step)
       return complete(command,
                       command_error(Failure::conflict, "a step is already running", "steps"));
-    // Pause, resume and reset cancel the running step; impulses and integrator changes
-    // apply between its chunks.
+    // Pause, resume, reset, seek and play cancel the running step; impulses, integrator
+    // changes, speed changes and reads apply between its chunks.
     if (!std::holds_alternative<ImpulseCommand>(command.kind) &&
-        !std::holds_alternative<SetIntegratorCommand>(command.kind))
+        !std::holds_alternative<SetIntegratorCommand>(command.kind) &&
+        !std::holds_alternative<SpeedCommand>(command.kind) &&
+        !std::holds_alternative<HistoryCommand>(command.kind) &&
+        !std::holds_alternative<RecordingCommand>(command.kind))
       finish_step("cancelled");
   }
   if (is_step) return start_step(command);
@@ -209,17 +242,126 @@ CommandOutcome SimLoop::run_command(CommandKind& kind) {
   if (auto* c = std::get_if<ResetCommand>(&kind)) return reset(*c);
   if (auto* c = std::get_if<ImpulseCommand>(&kind)) return impulse(*c);
   if (auto* c = std::get_if<SetIntegratorCommand>(&kind)) {
-    world_->set_integrator(c->integrator);
+    if (at_past()) timeline_.discard_future(*world_);
+    LoggedCommand logged;
+    logged.kind = LoggedKind::integrator;
+    logged.integrator = c->integrator;
+    apply_logged(*world_, logged);
+    log_command(std::move(logged));
     publish(Change::command);
     return IntegratorSet{c->integrator};
   }
-  const bool pause = std::holds_alternative<PauseCommand>(kind);
+  if (auto* c = std::get_if<SeekCommand>(&kind)) return seek(*c);
+  if (auto* c = std::get_if<PlayCommand>(&kind)) return play(*c);
+  if (auto* c = std::get_if<SpeedCommand>(&kind)) {
+    speed_ = c->speed;
+    anchor(Clock::now());
+    publish(Change::command);
+    return play_state();
+  }
+  if (std::holds_alternative<HistoryCommand>(kind)) return history();
+  if (std::holds_alternative<RecordingCommand>(kind)) return recording();
+  return pause_or_resume(std::holds_alternative<PauseCommand>(kind));
+}
+
+// Pause at a past step stops a playback and keeps the recorded future; resume there discards
+// it and goes on live ("resume from here"). Live, each change of state is logged.
+CommandOutcome SimLoop::pause_or_resume(bool pause) {
+  if (pause && playing_) {
+    playing_ = false;
+    paused_ = true;
+    publish(Change::command);
+    return PausedState{paused_};
+  }
+  if (!pause && at_past()) {
+    timeline_.discard_future(*world_);
+    playing_ = false;
+    paused_ = true;  // Logged below as a change to running.
+  }
   if (pause != paused_) {
     paused_ = pause;
+    LoggedCommand logged;
+    logged.kind = pause ? LoggedKind::pause : LoggedKind::resume;
+    log_command(std::move(logged));
     if (!paused_) anchor(Clock::now());
     publish(Change::command);
   }
   return PausedState{paused_};
+}
+
+CommandOutcome SimLoop::seek(const SeekCommand& c) {
+  if (!timeline_.enabled())
+    return command_error(Failure::conflict,
+                         "this world keeps no history (--history-s 0, or a checkpoint would not "
+                         "fit --history-mb)",
+                         "");
+  const TimelinePoint from = timeline_.from();
+  const TimelinePoint to = timeline_.head();
+  const std::string range = "the history holds steps " + std::to_string(from.step) + ".." +
+                            std::to_string(to.step) + " (time " + std::to_string(from.time) +
+                            ".." + std::to_string(to.time) + " s)";
+  std::optional<std::uint64_t> step = c.step;
+  if (c.time) {
+    step = timeline_.step_at(*c.time, world_->settings().dt);
+    if (!step) return command_error(Failure::invalid, "time out of range: " + range, "time");
+  }
+  std::optional<World> world = timeline_.restore(*step);
+  if (!world)
+    return command_error(Failure::invalid, "step out of range: " + range, c.time ? "time" : "step");
+  world_ = std::make_unique<World>(std::move(*world));
+  paused_ = true;
+  playing_ = false;
+  publish(Change::restart);
+  return SeekDone{world_->time(), world_->step_count()};
+}
+
+CommandOutcome SimLoop::play(const PlayCommand& c) {
+  if (at_past()) {
+    playing_ = true;
+    paused_ = false;
+    speed_ = c.speed;
+    anchor(Clock::now());
+    publish(Change::command);
+    return play_state();
+  }
+  speed_ = c.speed;
+  pause_or_resume(false);
+  anchor(Clock::now());
+  publish(Change::command);
+  return play_state();
+}
+
+PlayState SimLoop::play_state() const {
+  return {world_->time(), world_->step_count(), playing_, paused_, speed_};
+}
+
+CommandOutcome SimLoop::history() const {
+  HistoryReport r;
+  r.timeline = timeline_.summary();
+  r.at = {world_->step_count(), world_->time()};
+  r.live = !at_past();
+  r.playing = playing_;
+  r.paused = paused_;
+  r.speed = speed_;
+  r.bytes_limit = timeline_.bytes_limit();
+  r.history_s = timeline_.history_s();
+  return r;
+}
+
+CommandOutcome SimLoop::recording() const {
+  if (!timeline_.enabled())
+    return command_error(Failure::conflict,
+                         "this world keeps no history (--history-s 0, or a checkpoint would not "
+                         "fit --history-mb), so no recording",
+                         "");
+  std::optional<Recording> r = timeline_.recording(*world_);
+  if (!r)
+    return command_error(Failure::conflict,
+                         "the command log no longer reaches back to step 0 (--history-mb), or "
+                         "holds more than " + std::to_string(kMaxRecordingCommands) +
+                             " commands; a reset starts a new recording",
+                         "");
+  return RecordingReport{std::make_shared<const Recording>(std::move(*r))};
 }
 
 CommandOutcome SimLoop::reset(ResetCommand& c) {
@@ -236,6 +378,8 @@ CommandOutcome SimLoop::reset(ResetCommand& c) {
                          colon == std::string::npos ? "scene" : "scene." + what.substr(0, colon));
   }
   world_ = std::move(world);
+  playing_ = false;
+  timeline_.restart(*world_, world_->scene().world.name);
   new_scene_info();
   anchor(Clock::now());
   publish(Change::restart);
@@ -314,10 +458,14 @@ CommandOutcome SimLoop::impulse(const ImpulseCommand& c) {
   if (spin > kMaxSpin && spin > angular_velocity(b.s, b.c).norm())
     return command_error(Failure::invalid, "the impulse would give the body a spin over 1000 rad/s",
                          "impulse");
-  if (c.point)
-    world_->apply_impulse(id, c.impulse, *c.point);
-  else
-    world_->apply_impulse(id, c.impulse);
+  if (at_past()) timeline_.discard_future(*world_);
+  LoggedCommand logged;
+  logged.kind = LoggedKind::impulse;
+  logged.body = id;
+  logged.impulse = c.impulse;
+  logged.point = c.point;
+  apply_logged(*world_, logged);
+  log_command(std::move(logged));
   publish(Change::command);
   return ImpulseApplied{};
 }

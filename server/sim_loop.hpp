@@ -22,6 +22,7 @@
 #include "commands.hpp"
 #include "metrics.hpp"
 #include "snapshot.hpp"
+#include "timeline.hpp"
 #include "tumble/world.hpp"
 
 namespace tumble::server {
@@ -71,13 +72,20 @@ class SimLoop {
   /// last value stands (1 at start).
   static constexpr double kRtfMinWindow = 0.05;
 
+  /// Slowest and fastest live speed (POST …/speed), sim seconds per wall second.
+  static constexpr double kMinLiveSpeed = 0.1;
+  static constexpr double kMaxLiveSpeed = 4.0;
+  /// Slowest and fastest playback of the recorded future (POST …/play).
+  static constexpr double kMinPlaySpeed = 0.25;
+  static constexpr double kMaxPlaySpeed = 4.0;
+
   /// Builds the world (throws tumble::InvalidInput for an invalid scene) and publishes its
   /// first snapshot. Nothing runs until a SimPool services it. Each step runs on
   /// `step_threads` threads (the pool's thread and workers of the World's own; the same
-  /// result for any count).
+  /// result for any count). `timeline`: what its history keeps (docs/protocol.md, Timeline).
   SimLoop(Scene scene, Metrics& metrics,
           std::chrono::milliseconds step_command_budget = std::chrono::seconds(5),
-          unsigned step_threads = 1);
+          unsigned step_threads = 1, TimelineLimits timeline = {});
   /// Stops.
   ~SimLoop();
   SimLoop(const SimLoop&) = delete;
@@ -122,6 +130,15 @@ class SimLoop {
   void continue_step();
   void finish_step(const char* stopped);
   void world_step();
+  void after_step();
+  bool at_past() const;
+  void log_command(LoggedCommand command);
+  CommandOutcome pause_or_resume(bool pause);
+  CommandOutcome seek(const SeekCommand& c);
+  CommandOutcome play(const PlayCommand& c);
+  CommandOutcome history() const;
+  CommandOutcome recording() const;
+  PlayState play_state() const;
   void on_step_failure(const std::exception& e);
   CommandOutcome impulse(const ImpulseCommand& c);
   void anchor(Clock::time_point now);
@@ -134,7 +151,10 @@ class SimLoop {
   std::shared_ptr<const SceneInfo> scene_info_;
   std::uint64_t generation_ = 0;
   bool paused_ = false;
-  // The running real-time clock: sim_clock(w) = anchor_sim_ + (w − anchor_wall_).
+  bool playing_ = false;  // Replaying the recorded future from a past step.
+  double speed_ = 1.0;    // Sim seconds per wall second aimed at.
+  Timeline timeline_;
+  // The running real-time clock: sim_clock(w) = anchor_sim_ + speed_ · (w − anchor_wall_).
   Clock::time_point anchor_wall_{};
   double anchor_sim_ = 0.0;
   std::deque<std::pair<Clock::time_point, double>> rtf_samples_;  // (wall, sim time)

@@ -31,7 +31,7 @@ std::shared_ptr<const SceneInfo> make_scene_info(std::uint64_t generation, const
 double frame_time(const Snapshot& s, Clock::time_point at) {
   if (s.paused || !s.previous_bodies) return s.time;
   const double ahead = std::chrono::duration<double>(s.wall_time - at).count();
-  return std::clamp(s.time - ahead, s.previous_time, s.time);
+  return std::clamp(s.time - s.speed * ahead, s.previous_time, s.time);
 }
 
 nlohmann::json scene_json(const Snapshot& s) {
@@ -58,6 +58,9 @@ nlohmann::json state_json(const Snapshot& s) {
   return {{"time", s.time},
           {"step", s.step},
           {"paused", s.paused},
+          {"speed", s.speed},
+          {"live", s.live},
+          {"playing", s.playing},
           {"real_time_factor", s.real_time_factor},
           {"energy", s.energy},
           {"integrator", std::string(to_string(s.integrator))},

@@ -43,6 +43,10 @@ struct Snapshot {
   double time = 0.0;                                    ///< Sim time, s.
   std::uint64_t step = 0;                               ///< Steps since the reset.
   bool paused = false;                                  ///< Paused by a command.
+  double speed = 1.0;                                   ///< Sim s per wall s aimed at.
+  bool live = true;                                     ///< At the timeline's newest step.
+  bool playing = false;                                 ///< Replaying the recorded future.
+  std::size_t history_bytes = 0;                        ///< Estimated bytes of the timeline.
   double real_time_factor = 0.0;                        ///< Sim s per wall s (0 paused).
   double energy = 0.0;                                  ///< Total energy, J.
   Integrator integrator = Integrator::midpoint;         ///< In use now.
@@ -59,7 +63,8 @@ struct Snapshot {
 };
 
 /// The sim time a frame taken at wall instant `at` shows: `time` while paused or when no
-/// previous step is known, else the real-time clock clamped to [previous_time, time].
+/// previous step is known, else the real-time clock (at `speed`) clamped to
+/// [previous_time, time].
 double frame_time(const Snapshot& s, Clock::time_point at);
 
 /// The scene JSON as GET /api/scene returns it (with the integrator in use).

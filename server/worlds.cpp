@@ -33,7 +33,9 @@ HostedWorld::HostedWorld(std::string id, std::string token, std::string scene_ke
       token_(std::move(token)),
       scene_key_(std::move(scene_key)),
       sim_(std::move(scene), metrics, std::chrono::milliseconds(options.step_budget_ms),
-           static_cast<unsigned>(options.step_threads)),
+           static_cast<unsigned>(options.step_threads),
+           TimelineLimits{options.history_s,
+                          static_cast<std::size_t>(options.history_mb) << 20}),
       broadcaster_(ioc, sim_, metrics, std::chrono::milliseconds(options.render_ms),
                    static_cast<std::size_t>(options.max_viewers)),
       last_used_(Clock::now().time_since_epoch().count()) {}

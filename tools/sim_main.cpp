@@ -1,5 +1,7 @@
 // tumble-sim: runs a scene headless and prints a one-line JSON summary; optionally a CSV of
-// every body's state every N steps.
+// every body's state every N steps. `tumble-sim --replay FILE` replays a recording made by the
+// server (GET /api/recording) and says whether it ends in the same state: exit 0 match,
+// 1 mismatch, 2 unusable file (the message names the field).
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -10,6 +12,7 @@
 #include <boost/program_options.hpp>
 #include <nlohmann/json.hpp>
 
+#include "recording.hpp"
 #include "tumble/scene_io.hpp"
 #include "tumble/world.hpp"
 
@@ -28,11 +31,49 @@ struct Options {
   long every = 1;
   std::optional<std::string> csv;
   unsigned threads = tumble::World::hardware_threads();
+  std::optional<std::string> replay;
 };
 
 int usage_error(const std::string& message, const po::options_description& desc) {
   std::cerr << "tumble-sim: " << message << "\n\nusage: tumble-sim SCENE [options]\n" << desc;
   return kUsageError;
+}
+
+// Replays a recording file: exit 0 when the final state's digest matches the file's, 1 when
+// not, 2 when the file cannot be used.
+int replay_file(const std::string& path, unsigned threads) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::cerr << "tumble-sim: --replay: cannot read " << path << "\n";
+    return kUsageError;
+  }
+  nlohmann::json document;
+  try {
+    document = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    std::cerr << "tumble-sim: " << path << ": not JSON: " << e.what() << "\n";
+    return kUsageError;
+  }
+  tumble::server::Recording recording;
+  tumble::server::ReplayResult result;
+  try {
+    recording = tumble::server::parse_recording(document);
+    result = tumble::server::replay(recording, threads);
+  } catch (const tumble::server::RecordingError& e) {
+    std::cerr << "tumble-sim: " << path << ": field '" << e.field << "': " << e.what() << "\n";
+    return kUsageError;
+  }
+  const bool match = result.digest == recording.digest && result.step == recording.final_step;
+  nlohmann::json summary{{"replay", path},
+                         {"scene", recording.scene.world.name},
+                         {"commands", recording.commands.size()},
+                         {"final_step", result.step},
+                         {"final_time", result.time},
+                         {"digest", tumble::server::digest_hex(result.digest)},
+                         {"expected_digest", tumble::server::digest_hex(recording.digest)},
+                         {"match", match}};
+  std::cout << summary.dump() << std::endl;
+  return match ? 0 : 1;
 }
 
 void write_rows(std::ostream& out, const tumble::World& world) {
@@ -63,7 +104,9 @@ int main(int argc, char** argv) {
       ("toi", po::value<std::string>(), "bisection|root")
       ("every", po::value(&o.every), "CSV row every N steps (default 1)")
       ("threads", po::value(&o.threads), "threads per step (default: one per core); any count gives the same result")
-      ("csv", po::value<std::string>(), "write body states to this CSV file");
+      ("csv", po::value<std::string>(), "write body states to this CSV file")
+      ("replay", po::value<std::string>(), "replay this recording (GET /api/recording) and compare "
+                                           "its final state: exit 0 match, 1 mismatch, 2 bad file");
   po::options_description hidden;
   hidden.add_options()("scene", po::value(&o.scene));
   po::options_description all;
@@ -78,9 +121,14 @@ int main(int argc, char** argv) {
     return usage_error(e.what(), desc);
   }
   if (vm.count("help")) {
-    std::cout << "usage: tumble-sim SCENE [options]\nSCENE: a bundled name ("
+    std::cout << "usage: tumble-sim SCENE [options] | tumble-sim --replay FILE\nSCENE: a bundled name ("
               << nlohmann::json(tumble::bundled_scene_names()).dump() << ") or a path\n" << desc;
     return 0;
+  }
+  if (o.threads < 1 || o.threads > 256) return usage_error("--threads must be within [1, 256]", desc);
+  if (vm.count("replay")) {
+    if (!o.scene.empty()) return usage_error("--replay takes no SCENE", desc);
+    return replay_file(vm["replay"].as<std::string>(), o.threads);
   }
   if (o.scene.empty()) return usage_error("missing SCENE", desc);
   if (!(std::isfinite(o.duration) && o.duration >= 0.0 && o.duration <= 1e7))
