@@ -374,6 +374,12 @@ bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_heig
   return touching_vertices(s, c, floor_height + kSimultaneous).count >= 3;
 }
 
+bool at_rest_on_face(const BodyState& s, const BodyConstants& c, double floor_height) {
+  if (!s.P.isZero() || !s.L.isZero()) return false;
+  if (lowest_vertex_y(s, c) < floor_height - kContactBand) return false;
+  return touching_vertices(s, c, floor_height + kContactBand).count >= 3;
+}
+
 FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
   FloorStepResult result;
   BodyState& s = body.s;

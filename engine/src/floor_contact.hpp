@@ -27,6 +27,10 @@ double rest_speed(double restitution, const Vec3& gravity, double dt);
 /// vertices within 1e-9 m of it, none below): statically at rest, so it may start asleep.
 bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_height);
 
+/// True when the body is still (P = L = 0 to 1e-12) with three or more vertices within the
+/// resting contact's band (1e-6 m) of the floor: how a landed box comes to rest on a face.
+bool at_rest_on_face(const BodyState& s, const BodyConstants& c, double floor_height);
+
 /// Advances one awake body by dt: flight with the world's integrator, impacts located by
 /// the world's TOI method and answered with impulses, resting contact without sinking.
 FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt);

@@ -1,3 +1,6 @@
+#include <algorithm>
+
+#include "floor_contact.hpp"
 #include "pipeline.hpp"
 
 namespace tumble {
@@ -10,10 +13,18 @@ namespace {
 constexpr double kSleepSpeed = 0.05;  // m/s
 constexpr double kSleepTime = 0.5;    // s
 
-void update_still_time(Body& b, double dt) {
+// A body at rest on a face on the floor (momenta zero to 1e-12, three or more corners within
+// the resting contact's 1e-6 m of the floor: the exact floor contact leaves a landed box so) is in static equilibrium already:
+// the timer, there to tell a pause from rest, has nothing to tell, and the body counts as
+// still for all of it. As a body placed so starts asleep (World's constructor), a box that
+// lands and stops on a face sleeps at once instead of 0.5 s later. A box that stops
+// momentarily on an edge (two corners) still waits for the timer.
+void update_still_time(Body& b, double dt, const WorldDef& world) {
   if (b.activity != Activity::awake) return;
   const bool still = b.in_contact && point_speed_bound(b.s, b.c) <= kSleepSpeed;
   b.still_time = still ? b.still_time + dt : 0.0;
+  if (still && world.floor && at_rest_on_face(b.s, b.c, world.floor->height))
+    b.still_time = std::max(b.still_time, kSleepTime);
 }
 
 bool ready_to_sleep(const Body& b) {
@@ -55,7 +66,7 @@ void wake_island(ContactCache& cache, std::span<Body> bodies, std::uint32_t id) 
 
 void update_sleep(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
-  for (std::uint32_t id : s.stepped) update_still_time(ctx.bodies[id], ctx.dt);
+  for (std::uint32_t id : s.stepped) update_still_time(ctx.bodies[id], ctx.dt, ctx.world);
   for (std::size_t k = 0; k < s.island.count(); ++k) {
     const std::span<const std::uint32_t> members = s.island.island(k);
     bool still = true;

@@ -53,6 +53,23 @@ TEST(Sleep, SleepingBodyIsSkippedUntilAnImpulseWakesIt) {
 }
 
 // Same scene, same calls: bit-identical states.
+// A cube that lands flat on a floor with e = 0 stops dead on its face (P = L = 0): it is in
+// static equilibrium at once and sleeps on the next step, not after the 0.5 s timer that
+// tells a pause from rest. Dropped from 1 m it lands at √(2/9.81) = 0.4515 s.
+TEST(Sleep, ABoxThatStopsOnAFaceSleepsAtOnce) {
+  World world = world_from_json(R"({"dt": 0.004166666666666667,
+      "floor": {"height": 0, "restitution": 0, "friction": 1},
+      "bodies": [{"name": "cube", "position": [0, 1.5, 0]}]})");
+  double asleep_at = -1.0;
+  while (world.time() < 2.0 && asleep_at < 0.0) {
+    world.step();
+    if (world.awake_count() == 0) asleep_at = world.time();
+  }
+  EXPECT_GT(asleep_at, 0.4515);
+  EXPECT_LT(asleep_at, 0.4515 + 3 * world.settings().dt);
+  EXPECT_NEAR(world.body(0).s.x.y(), 0.5, 1e-9);
+}
+
 TEST(Determinism, SameScenesAndCallsGiveBitIdenticalStates) {
   auto run = [] {
     World world(load_scene("many"));
