@@ -1,4 +1,5 @@
 #include "report.hpp"
+#include "text.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -199,6 +200,9 @@ void assemble_docs(const Options& o, const std::string& command_line) {
     if (fs::exists(p)) d << read_all(p) << '\n';
   }
   d << closing_note(o, v);
+  // The server's own measurements (server_stream, server_load, server_worlds: not tumble-bench
+  // programs), kept by hand in bench/text/server.md and placed after the engine's.
+  d << '\n' << fill_template("server", {});
   fs::create_directories(fs::absolute(o.docs).parent_path());
   std::ofstream(o.docs) << d.str();
 }
