@@ -1,5 +1,7 @@
 #include "broadcaster.hpp"
 
+#include <cmath>
+
 #include <boost/asio/post.hpp>
 
 #include "frame.hpp"
@@ -8,6 +10,23 @@
 namespace tumble::server {
 
 namespace net = boost::asio;
+
+std::shared_ptr<const std::string> contacts_message(const ContactSet& set) {
+  const auto round = [](double v, double unit) { return std::round(v / unit) * unit; };
+  nlohmann::json points = nlohmann::json::array();
+  for (const ContactView& c : set.points) {
+    points.push_back({round(c.position.x(), 1e-4), round(c.position.y(), 1e-4),
+                      round(c.position.z(), 1e-4), round(c.normal.x(), 1e-4),
+                      round(c.normal.y(), 1e-4), round(c.normal.z(), 1e-4),
+                      round(c.impulse, 1e-6), c.solved ? 1 : 0});
+  }
+  const nlohmann::json message{{"type", "contacts"},
+                               {"step", set.step},
+                               {"points", std::move(points)},
+                               {"truncated", set.truncated}};
+  return std::make_shared<const std::string>(
+      message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+}
 
 Broadcaster::Broadcaster(net::io_context& ioc, SimLoop& sim, Metrics& metrics,
                          std::chrono::milliseconds interval, std::size_t max_viewers)
@@ -106,7 +125,13 @@ void Broadcaster::publish(Clock::time_point now) {
   const std::shared_ptr<const Snapshot> snap = sim_.latest();
   auto state = make_frame_state(*snap, frame_number_++, frame_time(*snap, now), previous_.get());
   auto status = status_if_due(*snap, *state);
-  store_.publish(state, snap->scene, std::move(status));
+  // Contacts are encoded once per snapshot that carries them, shared by the viewers that asked.
+  if (snap->contacts != contact_set_) {
+    contact_set_ = snap->contacts;
+    contact_text_ = contact_set_ ? contacts_message(*contact_set_) : nullptr;
+  }
+  store_.publish(state, snap->scene, std::move(status), contact_text_,
+                 contact_set_ ? contact_set_->step : 0);
   previous_ = std::move(state);
   metrics_.add_stream_cpu(thread_cpu_seconds() - cpu0);
 }

@@ -23,6 +23,10 @@ namespace tumble::server {
 
 class WsSession;
 
+/// The WebSocket "contacts" text message of `set` (docs/protocol.md, "WebSocket"): positions and
+/// normals rounded to 1e-4, impulses to 1e-6 N·s.
+std::shared_ptr<const std::string> contacts_message(const ContactSet& set);
+
 /// Frame timer plus the set of viewers (weak references, as in Beast's chat-multi example).
 class Broadcaster {
  public:
@@ -54,6 +58,8 @@ class Broadcaster {
   std::shared_ptr<const SceneInfo> current_scene() const { return sim_.latest()->scene; }
   /// The frames made so far, shared by the sessions.
   FrameStore& store() { return store_; }
+  /// A viewer turns contact points on (+1) or off (−1) (SimLoop::subscribe_contacts).
+  void subscribe_contacts(int delta) { sim_.subscribe_contacts(delta); }
   /// The frame interval.
   std::chrono::milliseconds interval() const { return interval_; }
 
@@ -79,6 +85,8 @@ class Broadcaster {
   std::uint32_t frame_number_ = 0;              // On strand_.
   std::uint32_t status_frame_ = 0;              // On strand_: frame of the last status.
   std::string status_key_;                      // On strand_: what forces a status now.
+  std::shared_ptr<const ContactSet> contact_set_;     // On strand_: the last contacts encoded…
+  std::shared_ptr<const std::string> contact_text_;  // …and their message.
   bool started_ = false;  // On strand_.
   bool stopped_ = false;  // On strand_.
   bool ticking_ = false;  // On strand_: a timer wait is pending.

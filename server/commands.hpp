@@ -88,10 +88,16 @@ struct RecordingReport {
   std::shared_ptr<const Recording> recording;  ///< Never null.
 };
 
+/// A body added (POST …/bodies, answered 201): its id and name.
+struct BodyAdded {
+  BodyId body = 0;   ///< Its index.
+  std::string name;  ///< Its name (given, or "box-<n>").
+};
+
 /// What a command did, as data: the simulation thread knows nothing of HTTP.
 using CommandOutcome =
     std::variant<CommandError, PausedState, SceneReset, IntegratorSet, ImpulseApplied, StepReport,
-                 SeekDone, PlayState, HistoryReport, RecordingReport>;
+                 SeekDone, PlayState, HistoryReport, RecordingReport, BodyAdded>;
 
 /// Builds a CommandError outcome.
 CommandOutcome command_error(Failure failure, std::string message, std::string field);
@@ -138,11 +144,18 @@ struct HistoryCommand {};
 /// Build the recording of the run up to the step shown (a read: changes nothing).
 struct RecordingCommand {};
 
+/// Add a body to the running world (logged: seek, playback and recordings apply it again).
+struct AddBodyCommand {
+  BodyDef definition;          ///< Parsed and checked like a scene body.
+  bool named = false;          ///< False: the body is named "box-<n>" (the first n free).
+  std::size_t max_bodies = 0;  ///< --max-bodies: a world already this big refuses (409).
+};
+
 /// What a command asks for.
 using CommandKind =
     std::variant<ResetCommand, PauseCommand, ResumeCommand, StepCommand, ImpulseCommand,
                  SetIntegratorCommand, SeekCommand, PlayCommand, SpeedCommand, HistoryCommand,
-                 RecordingCommand>;
+                 RecordingCommand, AddBodyCommand>;
 
 /// Called once with the outcome, on the simulation thread: must be cheap and must not throw
 /// (post the work to the caller's executor).

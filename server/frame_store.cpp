@@ -6,13 +6,17 @@ namespace tumble::server {
 
 void FrameStore::publish(std::shared_ptr<const FrameState> state,
                          std::shared_ptr<const SceneInfo> scene,
-                         std::shared_ptr<const nlohmann::json> status) {
+                         std::shared_ptr<const nlohmann::json> status,
+                         std::shared_ptr<const std::string> contacts,
+                         std::uint64_t contacts_step) {
   std::lock_guard lock(mutex_);
   // Sessions always take the newest frame: older encodings are never asked for again
   // (a session writing one holds its own reference).
   std::erase_if(cache_, [&](const auto& kv) { return kv.first.first != state->number; });
   newest_.state = std::move(state);
   newest_.scene = std::move(scene);
+  newest_.contacts = std::move(contacts);
+  newest_.contacts_step = contacts_step;
   if (status) {
     newest_.status = std::move(status);
     ++newest_.status_sequence;

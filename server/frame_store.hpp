@@ -23,14 +23,20 @@ struct Published {
   std::shared_ptr<const SceneInfo> scene;         ///< Its scene (message sent before it).
   std::shared_ptr<const nlohmann::json> status;   ///< Latest status fields.
   std::uint64_t status_sequence = 0;              ///< +1 per new status.
+  /// The "contacts" text message of the newest snapshot's step; null when no viewer asked.
+  std::shared_ptr<const std::string> contacts;
+  std::uint64_t contacts_step = 0;                ///< The step `contacts` is from.
 };
 
 /// Frame history and encoding cache.
 class FrameStore {
  public:
-  /// Publishes the newest frame; `status` (may be null: unchanged) becomes the latest status.
+  /// Publishes the newest frame; `status` (may be null: unchanged) becomes the latest status;
+  /// `contacts` (may be null: none asked for) the contacts message of step `contacts_step`.
   void publish(std::shared_ptr<const FrameState> state, std::shared_ptr<const SceneInfo> scene,
-               std::shared_ptr<const nlohmann::json> status);
+               std::shared_ptr<const nlohmann::json> status,
+               std::shared_ptr<const std::string> contacts = nullptr,
+               std::uint64_t contacts_step = 0);
   /// The newest publication (state null before the first).
   Published newest() const;
   /// The encoding of `state` relative to `base` (null: keyframe), made once and shared.

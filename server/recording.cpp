@@ -56,7 +56,7 @@ Vec3 vec_field(const json& v, const std::string& name) {
   return out;
 }
 
-LoggedCommand parse_command(const json& c, const std::string& prefix, std::size_t bodies) {
+LoggedCommand parse_command(const json& c, const std::string& prefix, std::size_t& bodies) {
   if (!c.is_object()) throw RecordingError(prefix.substr(0, prefix.size() - 1), "expected an object");
   LoggedCommand out;
   out.step = unsigned_field(c, "step", prefix);
@@ -85,9 +85,23 @@ LoggedCommand parse_command(const json& c, const std::string& prefix, std::size_
     out.impulse = vec_field(field(c, "impulse", prefix), prefix + "impulse");
     if (c.contains("point") && !c["point"].is_null())
       out.point = vec_field(c["point"], prefix + "point");
+  } else if (name == "add_body") {
+    out.kind = LoggedKind::add_body;
+    const std::uint64_t body = unsigned_field(c, "body", prefix);
+    if (body != bodies)
+      throw RecordingError(prefix + "body", "expected " + std::to_string(bodies) +
+                                                " (the next body index)");
+    out.body = static_cast<BodyId>(body);
+    try {
+      out.definition = std::make_shared<const BodyDef>(body_from_json(field(c, "definition", prefix)));
+    } catch (const SceneParseError& e) {
+      throw RecordingError(prefix + "definition" + (e.field.empty() ? "" : "." + e.field),
+                           e.what());
+    }
+    ++bodies;
   } else {
     throw RecordingError(prefix + "kind",
-                         "expected reset, impulse, integrator, pause or resume");
+                         "expected reset, impulse, integrator, pause, resume or add_body");
   }
   return out;
 }
@@ -101,6 +115,7 @@ const char* to_string(LoggedKind kind) {
     case LoggedKind::integrator: return "integrator";
     case LoggedKind::pause: return "pause";
     case LoggedKind::resume: return "resume";
+    case LoggedKind::add_body: return "add_body";
   }
   return "?";
 }
@@ -116,6 +131,14 @@ void apply_logged(World& world, const LoggedCommand& c) {
     case LoggedKind::integrator:
       world.set_integrator(c.integrator);
       return;
+    case LoggedKind::add_body: {
+      if (!c.definition) throw InvalidInput("add_body without a definition");
+      if (c.body != world.bodies().size())
+        throw InvalidInput("add_body: the world has " + std::to_string(world.bodies().size()) +
+                           " bodies, the log expects id " + std::to_string(c.body));
+      world.add_body(*c.definition);
+      return;
+    }
     case LoggedKind::reset:
     case LoggedKind::pause:
     case LoggedKind::resume:
@@ -155,11 +178,41 @@ json logged_json(const LoggedCommand& c) {
     case LoggedKind::reset:
       j["scene"] = c.scene;
       break;
+    case LoggedKind::add_body:
+      j["body"] = c.body;
+      j["definition"] = c.definition ? body_json(*c.definition) : json();
+      break;
     case LoggedKind::pause:
     case LoggedKind::resume:
       break;
   }
   return j;
+}
+
+json body_json(const BodyDef& body) {
+  Scene scene;
+  scene.bodies.push_back(body);
+  return scene_to_json(scene)["bodies"][0];
+}
+
+// scene_io parses bodies only within a scene: the body is parsed as the one body of an
+// otherwise default scene, and the field is named relative to it.
+BodyDef body_from_json(const json& body) {
+  try {
+    Scene scene = scene_from_json(json{{"bodies", json::array({body})}});
+    return std::move(scene.bodies.at(0));
+  } catch (const SceneParseError& e) {
+    static const std::string kAt = "bodies[0]";
+    std::string f = e.field;
+    std::string message = e.what();
+    if (f.starts_with(kAt)) {
+      f = f.substr(kAt.size());
+      if (f.starts_with(".")) f = f.substr(1);
+    }
+    if (message.starts_with(kAt + ".")) message = message.substr(kAt.size() + 1);
+    else if (message.starts_with(kAt)) message = "body" + message.substr(kAt.size());
+    throw SceneParseError(f, message);
+  }
 }
 
 json recording_json(const Recording& r) {
@@ -200,9 +253,10 @@ Recording parse_recording(const json& d) {
   if (!commands.is_array()) throw RecordingError("commands", "expected an array");
   if (commands.size() > kMaxRecordingCommands)
     throw RecordingError("commands", "more than " + std::to_string(kMaxRecordingCommands));
+  std::size_t bodies = r.scene.bodies.size();
   for (std::size_t i = 0; i < commands.size(); ++i) {
     const std::string prefix = "commands[" + std::to_string(i) + "].";
-    LoggedCommand c = parse_command(commands[i], prefix, r.scene.bodies.size());
+    LoggedCommand c = parse_command(commands[i], prefix, bodies);
     if (c.step > r.final_step) throw RecordingError(prefix + "step", "after final_step");
     if (!r.commands.empty() && c.step < r.commands.back().step)
       throw RecordingError(prefix + "step", "steps must not decrease");

@@ -5,6 +5,7 @@
 /// nlohmann-json) so that tumble-sim replays files without the server. Pure functions and plain
 /// data; not synchronised.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -27,6 +28,7 @@ enum class LoggedKind : std::uint8_t {
   integrator,  ///< World::set_integrator(integrator).
   pause,       ///< The loop paused; no effect on the World.
   resume,      ///< The loop resumed; no effect on the World.
+  add_body,    ///< World::add_body(definition); `body` is the id it got.
 };
 
 /// Name of a kind as written in JSON ("impulse" …).
@@ -43,10 +45,12 @@ struct LoggedCommand {
   std::optional<Vec3> point;        ///< impulse: m, world (none: the centre of mass).
   Integrator integrator = Integrator::exact;  ///< integrator: the new one.
   std::string scene;                ///< reset: the scene's name.
+  std::shared_ptr<const BodyDef> definition;  ///< add_body: the body added (never null then).
 };
 
-/// Applies a logged command to `world` exactly as the simulation did (impulse, integrator;
-/// the other kinds change nothing). Throws tumble::InvalidInput for a body out of range.
+/// Applies a logged command to `world` exactly as the simulation did (impulse, integrator,
+/// add_body; the other kinds change nothing). Throws tumble::InvalidInput for a body out of
+/// range, or an add_body the World refuses or whose id differs from the logged one.
 void apply_logged(World& world, const LoggedCommand& command);
 
 /// 64-bit FNV-1a over every body's state doubles in body order: x (3), R (9, column-major,
@@ -82,6 +86,13 @@ struct RecordingError : std::runtime_error {
       : std::runtime_error(message), field(std::move(field)) {}
   std::string field;  ///< "" for the whole document.
 };
+
+/// A body definition as a scene's body JSON (scene_io's schema).
+nlohmann::json body_json(const BodyDef& body);
+
+/// Parses one body definition with scene_io's rules; throws SceneParseError naming the field
+/// relative to the body ("mass", "size[1]"; "" for the whole value).
+BodyDef body_from_json(const nlohmann::json& body);
 
 /// Parses and checks a recording document; throws RecordingError naming the field.
 Recording parse_recording(const nlohmann::json& document);

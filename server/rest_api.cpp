@@ -5,6 +5,7 @@
 #include <initializer_list>
 
 #include "request_limits.hpp"
+#include "rest_routes.hpp"
 #include "sim_loop.hpp"
 #include "timeline_json.hpp"
 #include "tumble/scene_io.hpp"
@@ -15,14 +16,10 @@ namespace tumble::server {
 namespace http = boost::beast::http;
 using nlohmann::json;
 
-namespace {
 
-/// A request refused at the boundary (thrown by the parsers below, caught in handle_api).
-struct Refusal {
-  unsigned status;
-  std::string message;
-  std::string field;
-};
+using namespace rest;
+
+namespace {
 
 /// A route of one world: "/api/state" … (also under /api/worlds/{id}/…).
 using WorldHandler = void (*)(const Request&, ServerContext&, HostedWorld&, const Reply&);
@@ -40,89 +37,6 @@ struct ServerRoute {
   http::verb method;
   ServerHandler handler;
 };
-
-Response json_response(unsigned version, bool keep_alive, unsigned status, const json& body) {
-  Response res{static_cast<http::status>(status), version};
-  res.set(http::field::content_type, "application/json");
-  res.set(http::field::cache_control, "no-store");
-  res.keep_alive(keep_alive);
-  res.body() = body.dump(-1, ' ', false, json::error_handler_t::replace);
-  res.prepare_payload();
-  return res;
-}
-
-Response ok(const Request& req, const json& body) {
-  return json_response(req.version(), req.keep_alive(), 200, body);
-}
-
-// ---- Parsing at the boundary ---------------------------------------------------------
-
-json parse_body(const Request& req) {
-  const std::string& body = req.body();
-  // A raw NUL is never valid JSON, but nlohmann's lexer takes it for the end of the input:
-  // "{}\0garbage" would pass.
-  if (body.find('\0') != std::string::npos)
-    throw Refusal{400, "malformed JSON: NUL byte in the body", ""};
-  if (json_too_deep(body))
-    throw Refusal{400, "JSON nested deeper than " + std::to_string(kJsonDepthLimit), ""};
-  if (std::all_of(body.begin(), body.end(), [](unsigned char c) { return std::isspace(c); }))
-    return json::object();
-  json j;
-  try {
-    j = json::parse(body);
-  } catch (const json::parse_error& e) {
-    throw Refusal{400, std::string("malformed JSON: ") + e.what(), ""};
-  } catch (const json::exception& e) {  // e.g. 1e999: a number that is not finite as a double
-    throw Refusal{400, std::string("invalid JSON number: ") + e.what(), ""};
-  }
-  if (!j.is_object()) throw Refusal{400, "the request body must be a JSON object", ""};
-  return j;
-}
-
-void only_keys(const json& j, std::initializer_list<std::string_view> keys) {
-  for (const auto& [key, value] : j.items())
-    if (std::find(keys.begin(), keys.end(), key) == keys.end())
-      throw Refusal{400, "unknown field '" + quoted_prefix(key) + "'", quoted_prefix(key)};
-}
-
-const json& required(const json& j, const char* key) {
-  const auto it = j.find(key);
-  if (it == j.end()) throw Refusal{400, std::string("missing field '") + key + "'", key};
-  return *it;
-}
-
-// Three finite numbers, each within ±limit (finite but huge values such as 1e308 would
-// only make the body go non-finite a step later).
-Vec3 finite_vec3(const json& j, const char* field, double limit) {
-  if (!j.is_array() || j.size() != 3)
-    throw Refusal{400, "expected an array of 3 numbers", field};
-  Vec3 v;
-  for (int i = 0; i < 3; ++i) {
-    if (!j[i].is_number()) throw Refusal{400, "expected an array of 3 numbers", field};
-    v[i] = j[i].get<double>();
-    if (!std::isfinite(v[i])) throw Refusal{400, "numbers must be finite", field};
-    if (std::abs(v[i]) > limit)
-      throw Refusal{400, "each component must be within ±" + json(limit).dump(), field};
-  }
-  return v;
-}
-
-/// Largest impulse component accepted, N·s, and largest point coordinate, m (the scene's
-/// own position bound).
-constexpr double kMaxImpulse = 1e6;
-constexpr double kMaxPoint = 1e6;
-
-// ---- Commands ------------------------------------------------------------------------
-
-// The outcome becomes HTTP here, on whichever thread completes it (cheap: one JSON dump).
-void submit(HostedWorld& world, const Request& req, CommandKind kind, const Reply& reply) {
-  const unsigned version = req.version();
-  const bool keep_alive = req.keep_alive();
-  world.sim().submit({std::move(kind), [reply, version, keep_alive](CommandOutcome r) {
-                        reply(json_response(version, keep_alive, outcome_status(r),
-                                            outcome_json(r)));
-                      }});
-}
 
 Scene parse_scene(const json& scene) {
   const auto prefixed = [](const std::string& field) {
@@ -230,64 +144,6 @@ void post_integrator(const Request& req, ServerContext&, HostedWorld& world,
     throw Refusal{400, "unknown integrator '" + quoted_prefix(name.get<std::string>()) + "'",
                   "integrator"};
   submit(world, req, SetIntegratorCommand{*i}, reply);
-}
-
-// ---- Timeline (docs/protocol.md, "Timeline") -------------------------------------------
-
-double speed_field(const json& body, double lo, double hi, bool optional) {
-  if (!body.contains("speed")) {
-    if (optional) return 1.0;
-    throw Refusal{400, "missing field 'speed'", "speed"};
-  }
-  const json& speed = body["speed"];
-  if (!speed.is_number()) throw Refusal{400, "speed must be a number", "speed"};
-  const double f = speed.get<double>();
-  if (!(f >= lo && f <= hi))
-    throw Refusal{400, "speed must be in " + json(lo).dump() + ".." + json(hi).dump(), "speed"};
-  return f;
-}
-
-void post_seek(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
-  const json body = parse_body(req);
-  only_keys(body, {"time", "step"});
-  SeekCommand c;
-  if (body.contains("time") == body.contains("step"))
-    throw Refusal{400, "give exactly one of 'time' (s) and 'step'",
-                  body.contains("time") ? "step" : "time"};
-  if (body.contains("time")) {
-    if (!body["time"].is_number()) throw Refusal{400, "time must be a number", "time"};
-    c.time = body["time"].get<double>();
-  } else {
-    const json& step = body["step"];
-    if (!step.is_number_integer() || (!step.is_number_unsigned() && step.get<std::int64_t>() < 0))
-      throw Refusal{400, "step must be a non-negative integer", "step"};
-    c.step = step.get<std::uint64_t>();
-  }
-  submit(world, req, c, reply);
-}
-
-void post_play(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
-  const json body = parse_body(req);
-  only_keys(body, {"speed"});
-  submit(world, req,
-         PlayCommand{speed_field(body, SimLoop::kMinPlaySpeed, SimLoop::kMaxPlaySpeed, true)},
-         reply);
-}
-
-void post_speed(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
-  const json body = parse_body(req);
-  only_keys(body, {"speed"});
-  submit(world, req,
-         SpeedCommand{speed_field(body, SimLoop::kMinLiveSpeed, SimLoop::kMaxLiveSpeed, false)},
-         reply);
-}
-
-void get_history(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
-  submit(world, req, HistoryCommand{}, reply);
-}
-
-void get_recording(const Request& req, ServerContext&, HostedWorld& world, const Reply& reply) {
-  submit(world, req, RecordingCommand{}, reply);
 }
 
 // ---- Reads from the latest snapshot ----------------------------------------------------
@@ -401,6 +257,7 @@ constexpr WorldRoute kWorldRoutes[] = {
     {"/api/seek", http::verb::post, post_seek},
     {"/api/play", http::verb::post, post_play},
     {"/api/speed", http::verb::post, post_speed},
+    {"/api/bodies", http::verb::post, post_bodies},
 };
 
 /// Routes of the server as a whole.
@@ -647,6 +504,9 @@ json outcome_json(const CommandOutcome& outcome) {
     json operator()(const PlayState& p) const { return play_json(p); }
     json operator()(const HistoryReport& h) const { return history_json(h); }
     json operator()(const RecordingReport& r) const { return recording_json(*r.recording); }
+    json operator()(const BodyAdded& b) const {
+      return {{"ok", true}, {"body", b.body}, {"name", b.name}};
+    }
   };
   return std::visit(Visitor{}, outcome);
 }

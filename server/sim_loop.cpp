@@ -38,6 +38,7 @@ SimLoop::SimLoop(Scene scene, Metrics& metrics, std::chrono::milliseconds step_c
       timeline_(timeline),
       step_command_budget_(step_command_budget) {
   world_->set_threads(step_threads);
+  loaded_bodies_ = world_->bodies().size();
   timeline_.restart(*world_, world_->scene().world.name);
   new_scene_info();
   anchor(Clock::now());
@@ -180,6 +181,12 @@ void SimLoop::new_scene_info() {
 }
 
 void SimLoop::publish(Change change) {
+  // Bodies added (or, after a seek or a playback, fewer or more of them): a new scene for the
+  // viewers, and no interpolation across the change.
+  if (world_->bodies().size() != scene_info_->constants.size()) {
+    new_scene_info();
+    change = Change::restart;
+  }
   auto s = std::make_shared<Snapshot>();
   s->scene = scene_info_;
   s->time = world_->time();
@@ -205,6 +212,16 @@ void SimLoop::publish(Change change) {
   }
   s->wall_time = anchor_wall_ + std::chrono::duration_cast<Clock::duration>(
                                     std::chrono::duration<double>((s->time - anchor_sim_) / speed_));
+  if (contact_subscribers_.load(std::memory_order_relaxed) > 0) {
+    world_->contacts(contact_scratch_);
+    auto set = std::make_shared<ContactSet>();
+    set->step = s->step;
+    set->truncated = contact_scratch_.size() > ContactSet::kMaxPoints;
+    set->points.assign(contact_scratch_.begin(),
+                       contact_scratch_.begin() + static_cast<std::ptrdiff_t>(std::min(
+                                                      contact_scratch_.size(), ContactSet::kMaxPoints)));
+    s->contacts = std::move(set);
+  }
   latest_.store(std::move(s));
 }
 
@@ -218,6 +235,7 @@ void SimLoop::execute(Command& command) {
     // changes, speed changes and reads apply between its chunks.
     if (!std::holds_alternative<ImpulseCommand>(command.kind) &&
         !std::holds_alternative<SetIntegratorCommand>(command.kind) &&
+        !std::holds_alternative<AddBodyCommand>(command.kind) &&
         !std::holds_alternative<SpeedCommand>(command.kind) &&
         !std::holds_alternative<HistoryCommand>(command.kind) &&
         !std::holds_alternative<RecordingCommand>(command.kind))
@@ -251,6 +269,7 @@ CommandOutcome SimLoop::run_command(CommandKind& kind) {
     publish(Change::command);
     return IntegratorSet{c->integrator};
   }
+  if (auto* c = std::get_if<AddBodyCommand>(&kind)) return add_body(*c);
   if (auto* c = std::get_if<SeekCommand>(&kind)) return seek(*c);
   if (auto* c = std::get_if<PlayCommand>(&kind)) return play(*c);
   if (auto* c = std::get_if<SpeedCommand>(&kind)) {
@@ -366,6 +385,7 @@ CommandOutcome SimLoop::recording() const {
 
 CommandOutcome SimLoop::reset(ResetCommand& c) {
   Scene scene = c.scene ? std::move(*c.scene) : world_->scene();
+  if (!c.scene) scene.bodies.resize(std::min(scene.bodies.size(), loaded_bodies_));  // As loaded.
   std::unique_ptr<World> world;
   try {
     world = std::make_unique<World>(std::move(scene));
@@ -378,6 +398,7 @@ CommandOutcome SimLoop::reset(ResetCommand& c) {
                          colon == std::string::npos ? "scene" : "scene." + what.substr(0, colon));
   }
   world_ = std::move(world);
+  loaded_bodies_ = world_->bodies().size();
   playing_ = false;
   timeline_.restart(*world_, world_->scene().world.name);
   new_scene_info();
@@ -468,6 +489,51 @@ CommandOutcome SimLoop::impulse(const ImpulseCommand& c) {
   log_command(std::move(logged));
   publish(Change::command);
   return ImpulseApplied{};
+}
+
+// A body added at a past step discards the recorded future first, like an impulse. Its name
+// is the given one, or "box-<n>" with the first n (from the body count) no body has.
+CommandOutcome SimLoop::add_body(AddBodyCommand& c) {
+  if (world_->bodies().size() >= c.max_bodies)
+    return command_error(Failure::conflict,
+                         "the world has " + std::to_string(world_->bodies().size()) +
+                             " bodies; this server takes at most " +
+                             std::to_string(c.max_bodies) + " per world (--max-bodies)",
+                         "bodies");
+  BodyDef& def = c.definition;
+  BodyId existing = 0;
+  if (!c.named) {
+    for (std::size_t n = world_->bodies().size();; ++n) {
+      def.name = "box-" + std::to_string(n);
+      if (!world_->find_body(def.name, existing)) break;
+    }
+  } else if (world_->find_body(def.name, existing)) {
+    return command_error(Failure::invalid,
+                         "name: a body named '" + quoted_prefix(def.name) + "' exists already",
+                         "name");
+  }
+  if (at_past()) timeline_.discard_future(*world_);
+  LoggedCommand logged;
+  logged.kind = LoggedKind::add_body;
+  logged.body = static_cast<BodyId>(world_->bodies().size());
+  logged.definition = std::make_shared<const BodyDef>(def);
+  try {
+    apply_logged(*world_, logged);
+  } catch (const InvalidInput& e) {
+    // "bodies[12].mass: …": the request's field is "mass".
+    std::string what = e.what();
+    std::string field;
+    const std::size_t colon = what.find(": ");
+    const std::size_t dot = what.find("].");
+    if (colon != std::string::npos && dot != std::string::npos && dot < colon)
+      field = what.substr(dot + 2, colon - dot - 2);
+    if (dot != std::string::npos && dot < colon) what = what.substr(dot + 2);
+    return command_error(Failure::invalid, what, field);
+  }
+  const BodyAdded added{logged.body, def.name};
+  log_command(std::move(logged));
+  publish(Change::command);
+  return added;
 }
 
 }  // namespace tumble::server

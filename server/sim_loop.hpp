@@ -105,6 +105,11 @@ class SimLoop {
   void submit(Command command) { queue_.push(std::move(command)); }
   /// The latest published snapshot (never null).
   std::shared_ptr<const Snapshot> latest() const { return latest_.load(); }
+  /// Counts a viewer that wants contact points (+1) or no longer does (−1); while the count is
+  /// above 0 every published snapshot carries the last step's contacts. Thread-safe.
+  void subscribe_contacts(int delta) { contact_subscribers_.fetch_add(delta); }
+  /// Viewers that want contact points now. Thread-safe.
+  int contact_subscribers() const { return contact_subscribers_.load(); }
   /// Test seam: called on the simulation thread before every World::step; it may throw
   /// (std::bad_alloc, to check the loop survives it). Set before start().
   void set_before_step(std::function<void()> hook) { before_step_ = std::move(hook); }
@@ -141,6 +146,7 @@ class SimLoop {
   PlayState play_state() const;
   void on_step_failure(const std::exception& e);
   CommandOutcome impulse(const ImpulseCommand& c);
+  CommandOutcome add_body(AddBodyCommand& c);
   void anchor(Clock::time_point now);
   double sim_clock(Clock::time_point now) const;
   void publish(Change change);
@@ -166,6 +172,9 @@ class SimLoop {
   SnapshotSlot latest_;
   std::atomic<SimPool*> pool_{nullptr};
   std::atomic<bool> stopped_{false};
+  std::atomic<int> contact_subscribers_{0};
+  std::vector<ContactView> contact_scratch_;  // Simulation thread: World::contacts' buffer.
+  std::size_t loaded_bodies_ = 0;  // Bodies of the scene as loaded (a reset drops the added).
 };
 
 }  // namespace tumble::server

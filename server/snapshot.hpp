@@ -11,6 +11,7 @@
 
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
+#include "tumble/world.hpp"
 
 namespace tumble::server {
 
@@ -37,6 +38,15 @@ struct BodyPose {
   Activity activity = Activity::awake;   ///< awake / asleep / frozen.
 };
 
+/// The contact points of a step, for viewers that asked for them (WebSocket "contacts").
+struct ContactSet {
+  std::uint64_t step = 0;             ///< The step they are from.
+  std::vector<ContactView> points;    ///< At most kMaxPoints, in World::contacts order.
+  bool truncated = false;             ///< The step had more than kMaxPoints.
+  /// Most points kept per step.
+  static constexpr std::size_t kMaxPoints = 4096;
+};
+
 /// The simulation after a step (or a command).
 struct Snapshot {
   std::shared_ptr<const SceneInfo> scene;               ///< Never null.
@@ -60,6 +70,8 @@ struct Snapshot {
   /// Wall instant at which the running real-time clock reaches `time` (steps are taken
   /// ahead of the wall clock, so a frame at wall time w shows sim time time − (wall_time − w)).
   Clock::time_point wall_time{};
+  /// The last step's contacts; null unless a viewer subscribed (SimLoop::subscribe_contacts).
+  std::shared_ptr<const ContactSet> contacts;
 };
 
 /// The sim time a frame taken at wall instant `at` shows: `time` while paused or when no

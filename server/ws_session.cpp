@@ -134,12 +134,24 @@ void WsSession::on_read(beast::error_code ec, std::size_t) {
   do_read();
 }
 
-// The one client message understood: {"type": "ack", "frame": n}. Anything else is ignored.
+// The client messages understood: {"type": "ack", "frame": n[, "window": w]} and
+// {"type": "contacts", "on": bool}. Anything else is ignored.
 void WsSession::on_client_message() {
   const auto data = read_buffer_.cdata();
   const nlohmann::json j = nlohmann::json::parse(
       static_cast<const char*>(data.data()), static_cast<const char*>(data.data()) + data.size(),
       nullptr, /*allow_exceptions=*/false);
+  if (j.is_object() && j.size() == 2 && j.value("type", "") == "contacts" && j.contains("on") &&
+      j["on"].is_boolean()) {
+    const bool on = j["on"].get<bool>();
+    if (on != contacts_on_ && !finished_) {
+      contacts_on_ = on;
+      broadcaster_.subscribe_contacts(on ? 1 : -1);
+      contacts_step_sent_.reset();
+      contacts_due_ = on;
+    }
+    return;
+  }
   if (!j.is_object() || j.value("type", "") != "ack" || !j.contains("frame") ||
       !j["frame"].is_number_unsigned())
     return;
@@ -181,6 +193,11 @@ void WsSession::do_write() {
     generation_ = pub.state->generation;
     base_.reset();
     return write_text(pub.scene->message);
+  }
+  if (contacts_on_ && contacts_due_ && pub.contacts && pub.contacts_step != contacts_step_sent_) {
+    contacts_due_ = false;
+    contacts_step_sent_ = pub.contacts_step;
+    return write_text(pub.contacts);
   }
   if (pub.status && pub.status_sequence != status_sent_) {
     status_sent_ = pub.status_sequence;
@@ -231,6 +248,7 @@ void WsSession::on_write(bool is_frame, beast::error_code ec, std::size_t) {
     metrics_.add_frames_in_flight(-1);
     metrics_.count_frame_sent();
     metrics_.add_frame_bytes(in_flight_->size());
+    contacts_due_ = contacts_on_;
   }
   in_flight_.reset();
   if (ec) {
@@ -258,6 +276,7 @@ void WsSession::do_close() {
 void WsSession::finish() {
   if (finished_) return;
   finished_ = true;
+  if (std::exchange(contacts_on_, false)) broadcaster_.subscribe_contacts(-1);
   ping_timer_.cancel();
   pending_scene_.reset();
   base_.reset();

@@ -7,7 +7,9 @@
 /// slower than the frame rate gets fewer frames (each skipped one counts as dropped), never a
 /// stale one. A client that acknowledges frames (`{"type":"ack","frame":n,"window":w}`) is
 /// also held to w ≤ kAckWindow unacknowledged frames, so that a browser that reads its socket faster than it
-/// can process gets no queue either. Other client messages are ignored (over 4 KiB: the
+/// can process gets no queue either. A client that sends `{"type":"contacts","on":true}` gets,
+/// after each frame sent, the "contacts" text message of the newest step when that step differs
+/// from the last one sent (`"on":false` stops it). Other client messages are ignored (over 4 KiB: the
 /// connection is closed). Every half
 /// viewer timeout it sends a ping with a random payload; a viewer that has not echoed it in a
 /// pong within the timeout (it does not read, or reads too slowly to reach the ping) is
@@ -15,6 +17,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <boost/beast/core.hpp>
@@ -93,6 +96,9 @@ class WsSession : public std::enable_shared_from_this<WsSession> {
   bool acking_ = false;                               // The client acknowledges frames.
   std::size_t ack_window_ = kAckWindow;               // Its window (its last ack's).
   bool frame_waiting_ = false;                        // A newer frame exists, unsent.
+  bool contacts_on_ = false;                          // The viewer asked for contacts.
+  bool contacts_due_ = false;                         // A frame went out since the last.
+  std::optional<std::uint64_t> contacts_step_sent_;   // Step of the contacts sent last.
   bool accepted_ = false;
   bool writing_ = false;
   bool closing_ = false;
