@@ -1,7 +1,9 @@
-// User input: the lil-gui panel (pause / step / reset / scene / integrator / impulse / world),
-// keyboard shortcuts, and click-or-tap on a box to kick it.
+// User input: the lil-gui panel (pause / step / reset / scene / integrator / impulse / view /
+// world), keyboard shortcuts, and the pointer on a box: click or tap kicks it, a drag aims the
+// kick (aim.js), a long press (or a click with the inspector on) inspects it.
 import GUI from 'lil-gui';
 import { api } from './connection.js';
+import { KickAim } from './aim.js';
 import { currentWorld } from './world.js';
 import { WorldMenu } from './world_menu.js';
 
@@ -9,8 +11,8 @@ export const kIntegrators = ['euler', 'midpoint', 'rk4', 'symplectic_euler', 'sp
 
 /** A pointer that moves less than this (px) between down and up is a click, not an orbit. */
 const kClickSlopPx = 6;
-/** …and is released within this many ms. */
-const kClickMaxMs = 600;
+/** A press held still this long on a box inspects it instead of kicking, ms. */
+const kLongPressMs = 650;
 
 /** What the HUD says when a world refuses this page's commands (401). */
 export const kViewOnlyWorld = 'view only: this world belongs to another viewer; open its steer link to control it';
@@ -37,9 +39,15 @@ export class Controls {
       impulse: 3,
       frame: () => this.viewer.refit(),
     };
+    this.aim = new KickAim(viewer);
+    this.lastKick = null; // {body, impulse, point} of the newest kick sent
+    this.onInspect = () => {}; // set by main.js: (body index) → show it in the inspector
+    this.inspectOnClick = () => false; // …and whether a click inspects rather than kicks
+    this.extraShortcuts = {}; // more key → action pairs (main.js)
     this.#buildPanel();
     this.#bindPointer(viewer.renderer.domElement);
     this.#bindKeys();
+    this.#keepKeysAfterClicks(this.gui.domElement);
   }
 
   #buildPanel() {
@@ -58,9 +66,32 @@ export class Controls {
       .onChange((name) => this.#run(api.integrator(name), (r) => this.hud.setIntegrator(r.integrator ?? name)));
     gui.add(this.params, 'impulse', 0.1, 50, 0.1).name('impulse (N·s)');
     gui.add(this.params, 'frame').name('Frame bodies');
+    this.viewFolder = gui.addFolder('View');
     this.worldMenu = new WorldMenu(gui, this.hud);
-    if (window.matchMedia('(max-width: 640px)').matches) gui.close();
+    // On a phone the open panel would cover the scene: it starts folded, and folds when the
+    // window becomes phone-sized.
+    const phone = window.matchMedia('(max-width: 640px)');
+    if (phone.matches) gui.close();
+    phone.addEventListener('change', (e) => { if (e.matches) gui.close(); });
     this.loadSceneList();
+  }
+
+  /**
+   * Why: a clicked lil-gui button or menu keeps the keyboard focus, and space then activates
+   * that button again (Reset, then space: a second reset). Buttons and menus give the focus
+   * back after use; text fields keep it while typed in, until Enter or a change.
+   */
+  #keepKeysAfterClicks(panel) {
+    panel.addEventListener('click', (e) => {
+      const button = e.target.closest?.('button');
+      if (button) button.blur();
+    });
+    panel.addEventListener('change', (e) => {
+      if (e.target instanceof HTMLSelectElement || e.target.type === 'checkbox') e.target.blur();
+    });
+    panel.addEventListener('keydown', (e) => {
+      if (e.key === 'Enter' && e.target instanceof HTMLInputElement) e.target.blur();
+    });
   }
 
   /** Fills the scene menu from GET /api/scenes (kept as is when that fails). */
@@ -124,43 +155,105 @@ export class Controls {
     }
   }
 
+  /**
+   * A press on a box is ours (OrbitControls does not see it): released where it began it kicks
+   * along the view ray (or, with the inspector on, inspects); dragged, it aims (aim.js); held
+   * still for kLongPressMs, it inspects. A press elsewhere orbits, pans and zooms as before; a
+   * second finger hands the gesture back to the orbit controls.
+   */
   #bindPointer(canvas) {
-    const downs = new Map(); // pointerId → {x, y, t}
-    let multiTouch = false;
-    canvas.addEventListener('pointerdown', (e) => {
-      downs.set(e.pointerId, { x: e.clientX, y: e.clientY, t: performance.now() });
-      if (downs.size > 1) multiTouch = true;
-    });
-    const release = (e, cancelled) => {
-      const down = downs.get(e.pointerId);
-      downs.delete(e.pointerId);
-      const wasMulti = multiTouch;
-      if (downs.size === 0) multiTouch = false;
-      if (!down || cancelled || wasMulti || e.button > 0) return;
-      const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
-      if (moved <= kClickSlopPx && performance.now() - down.t <= kClickMaxMs) this.kick(e.clientX, e.clientY);
+    let press = null; // {id, x, y, hit, aiming, timer, done}
+    const end = () => {
+      if (!press) return;
+      clearTimeout(press.timer);
+      press = null;
+      this.aim.cancel();
+      this.viewer.controls.enabled = true;
     };
-    canvas.addEventListener('pointerup', (e) => release(e, false));
-    canvas.addEventListener('pointercancel', (e) => release(e, true));
+    // Capture phase on the container: decided before OrbitControls' own pointerdown runs.
+    canvas.parentElement.addEventListener('pointerdown', (e) => {
+      if (e.target !== canvas) return;
+      if (press) { end(); return; } // a second pointer: pinch or pan
+      if (e.button !== 0) return;
+      const hit = this.viewer.pick(e.clientX, e.clientY);
+      if (!hit) return;
+      this.viewer.controls.enabled = false;
+      canvas.setPointerCapture?.(e.pointerId);
+      press = { id: e.pointerId, x: e.clientX, y: e.clientY, hit, aiming: false, done: false };
+      press.timer = setTimeout(() => {
+        if (!press || press.aiming) return;
+        press.done = true;
+        this.onInspect(hit.body);
+      }, kLongPressMs);
+      this.aim.begin(hit);
+    }, { capture: true });
+    canvas.addEventListener('pointermove', (e) => {
+      if (!press || e.pointerId !== press.id || press.done) return;
+      if (!press.aiming && Math.hypot(e.clientX - press.x, e.clientY - press.y) <= kClickSlopPx) return;
+      press.aiming = true;
+      clearTimeout(press.timer);
+      this.aim.update(e.clientX, e.clientY);
+    });
+    canvas.addEventListener('pointerup', (e) => {
+      if (!press || e.pointerId !== press.id) return;
+      const { hit, aiming, done } = press;
+      if (aiming) {
+        this.aim.update(e.clientX, e.clientY);
+        const kick = this.aim.finish(this.params.impulse);
+        if (kick) this.#sendKick(kick.body, kick.impulse, kick.point);
+      } else if (!done) {
+        if (this.inspectOnClick()) this.onInspect(hit.body);
+        else this.kick(press.x, press.y);
+      }
+      end();
+    });
+    canvas.addEventListener('pointercancel', (e) => { if (press && e.pointerId === press.id) end(); });
   }
 
   /** Kicks the box under a client point: impulse along the view ray, applied at the hit point. */
   kick(x, y) {
     const hit = this.viewer.pick(x, y);
     if (!hit) return false;
-    const impulse = hit.direction.clone().multiplyScalar(this.params.impulse);
-    this.viewer.showKick(hit.point, hit.direction);
-    this.#run(api.impulse(hit.body, impulse.toArray(), hit.point.toArray()));
+    this.#sendKick(hit.body, hit.direction.clone().multiplyScalar(this.params.impulse), hit.point);
     return true;
   }
 
+  /** Shows the kick's arrow and posts it: impulse in N·s at world point `point`, m. */
+  #sendKick(body, impulse, point) {
+    this.viewer.showKick(point, impulse.clone().normalize());
+    this.lastKick = { body, impulse: impulse.toArray(), point: point.toArray() };
+    this.#run(api.impulse(body, this.lastKick.impulse, this.lastKick.point));
+  }
+
+  /**
+   * Shortcuts at the window, in the capture phase: they work wherever the focus is but in a
+   * text field being typed in, and space never also presses a focused button.
+   */
   #bindKeys() {
+    const typing = (t) => (t instanceof HTMLInputElement && t.type !== 'checkbox' && t.type !== 'range')
+      || t instanceof HTMLTextAreaElement || t instanceof HTMLSelectElement || t?.isContentEditable;
     window.addEventListener('keydown', (e) => {
-      if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
-      if (e.key === ' ') { e.preventDefault(); this.params.toggle(); }
-      else if (e.key === 's' && this.paused) this.params.step();
-      else if (e.key === 'r') this.params.reset();
-      else if (e.key === 'f') this.params.frame();
-    });
+      if (typing(e.target) || e.ctrlKey || e.metaKey || e.altKey) return;
+      const action = this.shortcuts[e.key];
+      if (!action) return;
+      e.preventDefault();
+      e.stopPropagation();
+      if (!e.repeat || e.key === 's') action();
+    }, { capture: true });
+    // A button activates on space's keyup: not when space is a shortcut.
+    window.addEventListener('keyup', (e) => {
+      if (e.key === ' ' && !typing(e.target)) e.preventDefault();
+    }, { capture: true });
+  }
+
+  /** Key → action of the keyboard shortcuts (web/README.md lists them). */
+  get shortcuts() {
+    return {
+      ' ': () => this.params.toggle(),
+      s: () => { if (this.paused) this.params.step(); },
+      r: () => this.params.reset(),
+      f: () => this.params.frame(),
+      ...this.extraShortcuts,
+    };
   }
 }

@@ -5,6 +5,11 @@ import { StateReader } from './shared_state.js';
 import { Hud } from './hud.js';
 import { EnergyPlot } from './plot.js';
 import { Controls } from './controls.js';
+import { Overlays } from './overlays.js';
+import { Inspector } from './inspector.js';
+import { SceneDrop } from './scene_drop.js';
+import { ViewMenu } from './view_menu.js';
+import { SceneCaption } from './caption.js';
 import { sceneIntegrator, sceneName } from './protocol.js';
 import { adoptTokenFromFragment, currentWorld, isWorldId, worldToken, worldUrl } from './world.js';
 
@@ -19,6 +24,17 @@ const viewer = createViewer();
 const hud = new Hud(document.getElementById('hud'), document.getElementById('toasts'));
 const plot = new EnergyPlot(document.getElementById('plot'), document.getElementById('energy'));
 const controls = new Controls(viewer, hud);
+const overlays = new Overlays(viewer);
+const inspector = new Inspector(document.getElementById('inspector'), viewer);
+const sceneDrop = new SceneDrop(document.getElementById('scene-error'), document.getElementById('drop-hint'), hud);
+const caption = new SceneCaption(document.getElementById('description'));
+const viewMenu = new ViewMenu(controls.viewFolder, {
+  viewer, overlays, inspector, sceneDrop, hud, sceneName: () => currentScene, simTime: () => drawnTime,
+});
+controls.onInspect = (i) => inspector.show(i);
+controls.inspectOnClick = () => viewMenu.inspectOnClick;
+inspector.onFollow = (i) => viewer.follow(i);
+controls.extraShortcuts = { p: () => viewMenu.screenshot(), Escape: () => { inspector.show(-1); viewer.follow(-1); } };
 hud.setWorld(world, worldToken(world) !== null);
 document.getElementById('default-world').href = worldUrl(null); // other parameters (?token=) kept
 
@@ -47,6 +63,9 @@ const handlers = {
   scene({ message }) {
     const name = sceneName(message.scene);
     viewer.setScene(message, { refit: name !== currentScene });
+    overlays.clear();
+    inspector.show(-1);
+    caption.show(message.scene?.description || sceneDrop.descriptionOf(name));
     currentScene = name;
     state = null;
     drawnFrame = null;
@@ -117,6 +136,7 @@ function drawNewest() {
   framesDrawn += 1;
   hud.onDrawn(state);
   plot.push(state.time, state.energy);
+  overlays.update(state.time);
   controls.setPaused(state.paused);
 }
 
@@ -152,7 +172,19 @@ window.tumble = Object.freeze({
   get canSteer() { return worldToken(world) !== null; },
   get notice() { return hud.notice; },
   get worldMissing() { return !document.getElementById('no-world').hidden; },
+  get description() { return caption.text; },
+  get following() { return viewer.following; },
+  get inspected() { return inspector.body; },
+  get inspectedState() { return inspector.latest; },
+  get lastKick() { return controls.lastKick; },
+  get downloads() { return viewMenu.downloads; },
+  get sceneError() { return sceneDrop.lastError; },
+  get camera() { return { position: viewer.camera.position.toArray(), target: viewer.controls.target.toArray() }; },
+  get viewDirection() { return viewer.viewDirection().toArray(); },
+  /** The energy plot's newest axis ticks: {x, y}, each {values, step, labels}. */
+  plotTicks: () => structuredClone(plot.ticks),
   bodyScreenPosition: (i) => viewer.bodyScreenPosition(i),
+  worldToScreen: (p) => viewer.worldToScreen(p),
 });
 
 requestAnimationFrame(animate);

@@ -1,5 +1,6 @@
 // Live plot of the total energy (frame header field) against sim time, with uPlot.
 import uPlot from 'uplot';
+import { energyRange, joulesLabels, secondsLabels } from './ticks.js';
 
 /** Seconds of sim time kept on the plot. */
 const kWindowSeconds = 20;
@@ -18,6 +19,12 @@ export class EnergyPlot {
     this.reference = null; // energy at the start of the current run, J
     this.lastDraw = 0;
     this.dirty = false;
+    this.ticks = { x: null, y: null }; // the axes' newest ticks: {values, step, labels}
+    const keep = (axis, format) => (u, values, axisIndex, space, step) => {
+      const labels = format(values, step);
+      this.ticks[axis] = { values: [...values], step, labels };
+      return labels;
+    };
     const axisStyle = { stroke: '#9aa4b2', grid: { stroke: 'rgba(255,255,255,0.07)', width: 1 },
       ticks: { stroke: 'rgba(255,255,255,0.15)', width: 1 }, font: '11px system-ui, sans-serif' };
     this.plot = new uPlot({
@@ -25,10 +32,12 @@ export class EnergyPlot {
       height: Math.max(container.clientHeight, 60),
       legend: { show: false },
       cursor: { show: false },
-      scales: { x: { time: false } },
+      scales: { x: { time: false }, y: { range: (u, min, max) => energyRange(min, max) } },
       axes: [
-        { ...axisStyle, size: 26, values: (u, ticks, axis, space, step) => ticks.map((t) => `${t.toFixed(decimalsFor(step))} s`) },
-        { ...axisStyle, size: 58, values: (u, ticks) => ticks.map(formatJoules) },
+        { ...axisStyle, size: 26, space: 44, values: keep('x', secondsLabels) },
+        // As wide as its longest label (about 6.2 px a character at 11 px).
+        { ...axisStyle, size: (u, values) => 14 + 6.2 * Math.max(5, ...(values ?? []).map((v) => v.length)),
+          values: keep('y', joulesLabels) },
       ],
       series: [{}, { label: 'E', stroke: '#f0a04b', width: 1.5, points: { show: false } }],
     }, [[], []], container);
@@ -85,11 +94,6 @@ export class EnergyPlot {
     }
     this.readout.textContent = `E ${formatJoules(e)}  ΔE ${drift >= 0 ? '+' : ''}${formatJoules(drift)}${relative}`;
   }
-}
-
-/** Decimals that tell apart ticks `step` apart (0 for whole seconds, 1 for 0.5 s, …). */
-function decimalsFor(step) {
-  return step > 0 && step < 1 ? Math.min(6, Math.ceil(-Math.log10(step) - 1e-9)) : 0;
 }
 
 function formatJoules(value) {

@@ -11,6 +11,10 @@ const kFrozenEdgeColor = new THREE.Color(0xff3030);
 const kMaxShadowExtent = 60; // m: beyond this the shadow map would be too coarse to be useful.
 const kMaxLabels = 16;
 const kKickMs = 700; // lifetime of the kick arrow
+/** Lowest the camera may look from: just above the horizontal plane through its target, rad. */
+const kMaxPolarAngle = Math.PI / 2 - 0.03;
+/** "Frame bodies" keeps bodies within this many robust standard deviations (1.4826 · MAD) of the median. */
+const kFrameSigmas = 3;
 
 // The 12 box edges as vertex-index pairs (vertex i: bit 0 → +x, bit 1 → +y, bit 2 → +z).
 const kEdges = [[0, 1], [2, 3], [4, 5], [6, 7], [0, 2], [1, 3], [4, 6], [5, 7], [0, 4], [1, 5], [2, 6], [3, 7]];
@@ -96,6 +100,10 @@ export class Viewer {
     this.controls.enableDamping = true;
     this.controls.dampingFactor = 0.08;
     this.controls.target.set(0, 1, 0);
+    // The camera never goes under the floor: it stays above the horizontal plane through its
+    // target, and render() keeps the target on or above the floor.
+    this.controls.maxPolarAngle = kMaxPolarAngle;
+    this.following = -1; // body the camera follows, or -1
 
     this.#addLights();
     this.floor = this.#makeFloor();
@@ -180,6 +188,9 @@ export class Viewer {
     this.faces = faces;
     this.baseColors = bodies.map((b) => new THREE.Color(b.color ?? '#d9822b'));
     this.bodyNames = bodies.map((b, i) => b.name ?? `body ${i}`);
+    this.bodySizes = bodies.map((b, i) => b.size ?? scene?.bodies?.[i]?.size ?? [1, 1, 1]);
+    this.bodyMasses = (scene?.bodies ?? []).map((b) => b.mass ?? 1);
+    this.following = -1;
     this.activity = new Uint8Array(n);
     this.hasPose = false;
     this.sceneBounds = initialBounds(scene);
@@ -313,11 +324,39 @@ export class Viewer {
     this.sun.position.copy(center).addScaledVector(this.sunDirection, 2 * r + 10);
   }
 
-  /** Frames the bodies: the camera looks at their bounds from above and to the side. */
+  /**
+   * Bounds of the bulk of the bodies: those whose centre lies within kFrameSigmas robust
+   * standard deviations (1.4826 × the median absolute deviation, per axis) of the median centre,
+   * so one runaway body does not shrink the rest to a speck. Null before the first pose.
+   */
+  bulkBounds() {
+    if (!this.hasPose || this.bodyCount === 0) return null;
+    const n = this.bodyCount, centres = [];
+    for (let i = 0; i < n; i++) {
+      const c = this.bodyCentre(i);
+      if (Number.isFinite(c.x + c.y + c.z)) centres.push([i, c]);
+    }
+    if (centres.length === 0) return null;
+    const limits = ['x', 'y', 'z'].map((axis) => {
+      const values = centres.map(([, c]) => c[axis]);
+      const mid = median(values);
+      const mad = median(values.map((v) => Math.abs(v - mid)));
+      // A floor under the spread: bodies in a row (MAD 0 across it) are never cut.
+      return { axis, mid, reach: Math.max(kFrameSigmas * 1.4826 * mad, 1) };
+    });
+    const box = new THREE.Box3(), v = this.frameVertices, p = new THREE.Vector3();
+    for (const [i, c] of centres) {
+      if (!limits.every(({ axis, mid, reach }) => Math.abs(c[axis] - mid) <= reach)) continue;
+      for (let k = 0; k < 8; k++) box.expandByPoint(p.fromArray(v, i * 24 + k * 3));
+    }
+    return box.isEmpty() ? null : box;
+  }
+
+  /** Frames the bodies: the camera looks at the bulk's bounds from above and to the side. */
   #fitCamera() {
     const box = new THREE.Box3();
-    const current = this.#bodiesSphere();
-    if (current) current.getBoundingBox(box);
+    const current = this.bulkBounds();
+    if (current) box.copy(current);
     if (this.sceneBounds) box.union(this.sceneBounds);
     if (box.isEmpty()) return;
     if (this.floorHeight !== null) box.expandByPoint(new THREE.Vector3(box.min.x, this.floorHeight, box.min.z));
@@ -347,6 +386,11 @@ export class Viewer {
     this.needsFit = true;
   }
 
+  /** Keeps body `i` at the centre of the view as it moves (-1 or null: stop following). */
+  follow(i) {
+    this.following = Number.isInteger(i) && i >= 0 && i < this.bodyCount ? i : -1;
+  }
+
   /**
    * The body under a canvas point, with the world hit point and the view ray's direction.
    * @param {number} x client x, px  @param {number} y client y, px
@@ -366,13 +410,26 @@ export class Viewer {
   /** Screen position (client px) of a body's centre, or null when it has no pose. */
   bodyScreenPosition(i) {
     if (!this.hasPose || i < 0 || i >= this.bodyCount) return null;
-    const c = this.#bodyCentre(i);
+    const c = this.bodyCentre(i);
     c.project(this.camera);
     const rect = this.renderer.domElement.getBoundingClientRect();
     return { x: rect.left + ((c.x + 1) / 2) * rect.width, y: rect.top + ((1 - c.y) / 2) * rect.height, visible: c.z < 1 };
   }
 
-  #bodyCentre(i) {
+  /** Client px of a world point (Vector3 or [x, y, z], m), with `visible` false behind the camera. */
+  worldToScreen(point) {
+    const c = (Array.isArray(point) ? new THREE.Vector3(...point) : point.clone()).project(this.camera);
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    return { x: rect.left + ((c.x + 1) / 2) * rect.width, y: rect.top + ((1 - c.y) / 2) * rect.height, visible: c.z < 1 };
+  }
+
+  /** Unit vector the camera looks along (world frame). */
+  viewDirection() {
+    return this.camera.getWorldDirection(new THREE.Vector3());
+  }
+
+  /** Centre of body `i` as drawn (the mean of its 8 vertices), m. */
+  bodyCentre(i) {
     const v = this.frameVertices, c = new THREE.Vector3();
     for (let k = 0; k < 8; k++) c.x += v[i * 24 + k * 3], c.y += v[i * 24 + k * 3 + 1], c.z += v[i * 24 + k * 3 + 2];
     return c.multiplyScalar(1 / 8);
@@ -417,6 +474,25 @@ export class Viewer {
     });
   }
 
+  /** Moves camera and target together by the followed body's displacement: the view keeps its angle. */
+  #followBody() {
+    if (this.following < 0 || !this.hasPose || this.following >= this.bodyCount) return;
+    const c = this.bodyCentre(this.following);
+    if (!Number.isFinite(c.x + c.y + c.z)) return;
+    const delta = c.sub(this.controls.target);
+    this.camera.position.add(delta);
+    this.controls.target.add(delta);
+  }
+
+  /** A target panned under the floor is lifted back onto it (with the camera). */
+  #keepAboveFloor() {
+    if (this.floorHeight === null || this.floorHeight === undefined) return;
+    const below = this.floorHeight - this.controls.target.y;
+    if (below <= 0) return;
+    this.controls.target.y += below;
+    this.camera.position.y += below;
+  }
+
   resize() {
     const w = this.container.clientWidth, h = this.container.clientHeight;
     this.camera.aspect = w / Math.max(h, 1);
@@ -425,6 +501,8 @@ export class Viewer {
   }
 
   render() {
+    this.#followBody();
+    this.#keepAboveFloor();
     this.controls.update();
     // Keep the (finite) floor under the view, moved by whole grid tiles so the grid stays put.
     const t = this.controls.target;
@@ -434,4 +512,11 @@ export class Viewer {
     this.#updateKicks(performance.now());
     this.renderer.render(this.scene, this.camera);
   }
+}
+
+/** The median of a non-empty list of numbers. */
+function median(values) {
+  const sorted = Float64Array.from(values).sort();
+  const mid = sorted.length >> 1;
+  return sorted.length % 2 ? sorted[mid] : (sorted[mid - 1] + sorted[mid]) / 2;
 }
