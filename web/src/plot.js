@@ -36,7 +36,7 @@ export class EnergyPlot {
       axes: [
         { ...axisStyle, size: 26, space: 44, values: keep('x', secondsLabels) },
         // As wide as its longest label (about 6.2 px a character at 11 px).
-        { ...axisStyle, size: (u, values) => 14 + 6.2 * Math.max(5, ...(values ?? []).map((v) => v.length)),
+        { ...axisStyle, space: 18, size: (u, values) => 14 + 6.2 * Math.max(5, ...(values ?? []).map((v) => v.length)),
           values: keep('y', joulesLabels) },
       ],
       series: [{}, { label: 'E', stroke: '#f0a04b', width: 1.5, points: { show: false } }],

@@ -82,14 +82,16 @@ export class SceneDrop {
       this.#showError(file.name, '', 'a scene file holds one JSON object', undefined);
       return false;
     }
+    // Known before the reset answers: the new scene's message may come first.
+    this.loaded = { name: scene.name ?? 'untitled', description: scene.description ?? '' };
     try {
       await api.reset(scene);
     } catch (e) {
+      this.loaded = null;
       this.#showError(file.name, e.field ?? '', e.message, valueAtField(scene, e.field));
       return false;
     }
     this.#hideError();
-    this.loaded = { name: scene.name ?? 'untitled', description: scene.description ?? '' };
     this.hud.toast(`loaded ${file.name}`, 'info');
     return true;
   }

@@ -44,13 +44,13 @@ export function joulesLabels(ticks, step) {
 }
 
 /**
- * The y range of an energy plot holding [min, max] J: at least a span of 1e-4 of the energy
- * (and 0.01 J), so a settled world's flat line gets a few readable ticks instead of labels
+ * The y range of an energy plot holding [min, max] J: at least a span of 2e-4 of the energy
+ * (and 0.05 J), so a settled world's flat line gets a few readable ticks instead of labels
  * that differ in the ninth digit.
  */
 export function energyRange(min, max) {
   if (!Number.isFinite(min) || !Number.isFinite(max)) return [0, 1];
   const mid = (min + max) / 2;
-  const span = Math.max(max - min, 1e-4 * Math.abs(mid), 0.01);
+  const span = Math.max(max - min, 2e-4 * Math.abs(mid), 0.05);
   return [mid - 0.55 * span, mid + 0.55 * span];
 }
