@@ -221,10 +221,28 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
         assert.ok(left >= 0 && right <= 390.5, `#${id} fits the 390 px width (${left}..${right})`);
       }
       const index = 0;
+      // The target is taken from a frame drawn at the phone size (canvas resized), and must be
+      // the canvas itself at that point: on a phone the panel folds, so it cannot cover it.
+      await until('the canvas at the phone size', () => page.evaluate(() => {
+        const c = document.querySelector('#stage canvas');
+        return c.clientWidth === innerWidth && c.clientHeight === innerHeight;
+      }));
+      const drawn = await page.evaluate(() => window.tumble.framesDrawn);
+      await until('a frame drawn at the phone size', () => page.evaluate((n) => window.tumble.framesDrawn > n, drawn));
       const target = await page.evaluate((i) => window.tumble.bodyScreenPosition(i), index);
-      assert.ok(target?.visible, 'a body is in view');
+      assert.ok(target?.visible && target.x > 0 && target.x < 390 && target.y > 0 && target.y < 760,
+        `body ${index} is on the phone's screen (${JSON.stringify(target)})`);
+      const atTarget = await page.evaluate(([x, y]) => {
+        const el = document.elementFromPoint(x, y);
+        return el?.closest('#panel') ? 'the panel' : el?.tagName === 'CANVAS' ? 'canvas' : `${el?.tagName}#${el?.id}`;
+      }, [target.x, target.y]);
+      assert.equal(atTarget, 'canvas', 'nothing covers the body where it is tapped');
       const before = (await getJson(base, 'state')).bodies[index];
+      const kickBefore = await page.evaluate(() => JSON.stringify(window.tumble.lastKick));
       await page.touchscreen.tap(target.x, target.y);
+      const kick = await until('the page to send a kick for the tap', () => page.evaluate(
+        (old) => JSON.stringify(window.tumble.lastKick) !== old && window.tumble.lastKick, kickBefore), 5000);
+      assert.equal(kick.body, index, 'the tap kicks the body tapped');
       await until('the tap to change the body velocity', async () => {
         const body = (await getJson(base, 'state')).bodies[index];
         return Math.hypot(...body.velocity.map((v, k) => v - before.velocity[k])) > 0.5;
