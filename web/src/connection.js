@@ -179,6 +179,18 @@ export const api = {
   integrator: (integrator) => request('POST', worldPath('integrator'), { integrator }),
   /** impulse in N·s and point in metres, world frame. */
   impulse: (body, impulse, point) => request('POST', worldPath('impulse'), { body, impulse, point }),
+  /** The world's timeline: range, markers, live/playing/speed (docs/protocol.md, "Timeline"). */
+  history: () => request('GET', worldPath('history')),
+  /** Shows the step nearest sim time `time` (s), paused. */
+  seek: (time) => request('POST', worldPath('seek'), { time }),
+  /** Shows step `step`, paused. */
+  seekStep: (step) => request('POST', worldPath('seek'), { step }),
+  /** Plays the recorded future at `speed` × real time (live: resumes at that speed). */
+  play: (speed) => request('POST', worldPath('play'), { speed }),
+  /** Sets the pace of the live loop and of a playback, sim s per wall s (0.1–4). */
+  speed: (speed) => request('POST', worldPath('speed'), { speed }),
+  /** Adds a box: {name?, size, mass, position, velocity, …} as a scene body (docs/scenes.md). */
+  addBody: (body) => request('POST', worldPath('bodies'), body),
   /** The server's worlds: {worlds: [{id, scene, bodies, viewers, real_time_factor, paused, time}], max_worlds}. */
   worlds: () => request('GET', 'worlds'),
   /** One world's entry; ApiError with status 404 when there is none. */

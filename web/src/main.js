@@ -10,6 +10,7 @@ import { Inspector } from './inspector.js';
 import { SceneDrop } from './scene_drop.js';
 import { ViewMenu } from './view_menu.js';
 import { SceneCaption } from './caption.js';
+import { Timeline } from './timeline.js';
 import { sceneIntegrator, sceneName } from './protocol.js';
 import { adoptTokenFromFragment, currentWorld, isWorldId, worldToken, worldUrl } from './world.js';
 
@@ -28,6 +29,7 @@ const overlays = new Overlays(viewer);
 const inspector = new Inspector(document.getElementById('inspector'), viewer);
 const sceneDrop = new SceneDrop(document.getElementById('scene-error'), document.getElementById('drop-hint'), hud);
 const caption = new SceneCaption(document.getElementById('description'));
+const timeline = new Timeline(document.getElementById('timeline'), hud);
 const viewMenu = new ViewMenu(controls.viewFolder, {
   viewer, overlays, inspector, sceneDrop, hud, sceneName: () => currentScene, simTime: () => drawnTime,
 });
@@ -81,6 +83,7 @@ const handlers = {
   },
   status({ message }) {
     hud.setServerState(message);
+    timeline.onStatus(message);
     if (message.integrator) controls.setIntegrator(message.integrator);
   },
   connection({ state: s, detail, connects: n }) {
@@ -137,6 +140,7 @@ function drawNewest() {
   hud.onDrawn(state);
   plot.push(state.time, state.energy);
   overlays.update(state.time);
+  timeline.onDrawn(state.time);
   controls.setPaused(state.paused);
 }
 
@@ -179,6 +183,8 @@ window.tumble = Object.freeze({
   get lastKick() { return controls.lastKick; },
   get downloads() { return viewMenu.downloads; },
   get sceneError() { return sceneDrop.lastError; },
+  get timeline() { return timeline.history && structuredClone(timeline.history); },
+  get seeks() { return timeline.seeks; },
   get camera() { return { position: viewer.camera.position.toArray(), target: viewer.controls.target.toArray() }; },
   get viewDirection() { return viewer.viewDirection().toArray(); },
   /** The energy plot's newest axis ticks: {x, y}, each {values, step, labels}. */
