@@ -18,10 +18,12 @@ const kMaxDelayMs = 5000;
  * worker (stream_worker.js), whose event loop a busy page does not block.
  */
 export class StreamConnection {
-  constructor(url, { onScene, onStatus, onFrame, onState, onError }) {
+  constructor(url, { onScene, onStatus, onFrame, onState, onError, onMessage }) {
     this.url = url;
     this.onScene = onScene;
     this.onStatus = onStatus;
+    this.onMessage = onMessage ?? (() => {}); // other text messages (contacts, …)
+    this.subscriptions = new Map(); // type → the opt-in text re-sent on every new connection
     this.onFrame = onFrame;
     this.bytesReceived = 0; // message payload bytes since the page loaded
     this.ackWindow = () => 4; // frames the server may have in flight (docs/protocol.md, "ack")
@@ -58,6 +60,7 @@ export class StreamConnection {
     socket.onopen = () => {
       this.attempt = 0;
       this.connects += 1;
+      for (const text of this.subscriptions.values()) socket.send(text);
       this.#setState('open');
     };
     socket.onmessage = (event) => {
@@ -68,6 +71,7 @@ export class StreamConnection {
           const message = parseTextMessage(event.data);
           if (message?.type === 'scene') this.onScene(message);
           else if (message?.type === 'status') this.onStatus(message);
+          else if (message?.type) this.onMessage(message);
         } else {
           this.bytesReceived += event.data.byteLength;
           const frame = decodeFrame(event.data);
@@ -85,6 +89,17 @@ export class StreamConnection {
       this.#scheduleRetry();
     };
     socket.onerror = () => {}; // onclose follows and handles the retry.
+  }
+
+  /**
+   * Sends an opt-in message (`{"type": "contacts", "on": true}`) now and on every later
+   * connection; `on` false sends it once and forgets it.
+   */
+  subscribe(type, on) {
+    const text = JSON.stringify({ type, on });
+    if (on) this.subscriptions.set(type, text);
+    else this.subscriptions.delete(type);
+    if (this.socket?.readyState === WebSocket.OPEN) this.socket.send(text);
   }
 
   #scheduleRetry() {

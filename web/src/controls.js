@@ -4,6 +4,7 @@
 import GUI from 'lil-gui';
 import { api } from './connection.js';
 import { KickAim } from './aim.js';
+import { AddBoxMenu } from './add_box.js';
 import { currentWorld } from './world.js';
 import { WorldMenu } from './world_menu.js';
 
@@ -37,6 +38,7 @@ export class Controls {
       scene: '',
       integrator: 'exact',
       impulse: 3,
+      speed: 1,
       frame: () => this.viewer.refit(),
     };
     this.aim = new KickAim(viewer);
@@ -65,8 +67,12 @@ export class Controls {
     this.integratorController = gui.add(this.params, 'integrator', kIntegrators).name('integrator')
       .onChange((name) => this.#run(api.integrator(name), (r) => this.hud.setIntegrator(r.integrator ?? name)));
     gui.add(this.params, 'impulse', 0.1, 50, 0.1).name('impulse (N·s)');
+    // Slow motion: the pace of the live run (POST …/speed; the timeline bar offers 0.25–4×).
+    this.speedController = gui.add(this.params, 'speed', 0.1, 1, 0.05).name('speed (×)')
+      .onFinishChange((v) => this.#run(api.speed(v)));
     gui.add(this.params, 'frame').name('Frame bodies');
     this.viewFolder = gui.addFolder('View');
+    this.addBox = new AddBoxMenu(gui, this.hud);
     this.worldMenu = new WorldMenu(gui, this.hud);
     // On a phone the open panel would cover the scene: it starts folded, and folds when the
     // window becomes phone-sized.
@@ -122,6 +128,13 @@ export class Controls {
     if (!name || !kIntegrators.includes(name)) return;
     this.params.integrator = name;
     this.integratorController.updateDisplay();
+  }
+
+  /** Shows the server's speed (status message) on the slow-motion slider, when it is within it. */
+  setSpeed(speed) {
+    if (!Number.isFinite(speed) || speed === this.params.speed || speed > 1) return;
+    this.params.speed = speed;
+    this.speedController.updateDisplay();
   }
 
   /** Follows the server's paused flag (from every frame). */

@@ -32,6 +32,7 @@ const caption = new SceneCaption(document.getElementById('description'));
 const timeline = new Timeline(document.getElementById('timeline'), hud);
 const viewMenu = new ViewMenu(controls.viewFolder, {
   viewer, overlays, inspector, sceneDrop, hud, sceneName: () => currentScene, simTime: () => drawnTime,
+  subscribe: (what, on) => worker.postMessage({ type: 'subscribe', what, on }),
 });
 controls.onInspect = (i) => inspector.show(i);
 controls.inspectOnClick = () => viewMenu.inspectOnClick;
@@ -84,6 +85,7 @@ const handlers = {
   status({ message }) {
     hud.setServerState(message);
     timeline.onStatus(message);
+    controls.setSpeed(message.speed);
     if (message.integrator) controls.setIntegrator(message.integrator);
   },
   connection({ state: s, detail, connects: n }) {
@@ -93,6 +95,9 @@ const handlers = {
     if (s === 'open' && n > 1) controls.loadSceneList();
     if (s === 'open') hud.setMissingWorld(null);
     else checkWorld();
+  },
+  message({ message }) {
+    if (message.type === 'contacts') overlays.showContacts(message);
   },
   error({ message }) {
     console.warn('tumble stream:', message);
@@ -185,6 +190,7 @@ window.tumble = Object.freeze({
   get sceneError() { return sceneDrop.lastError; },
   get timeline() { return timeline.history && structuredClone(timeline.history); },
   get seeks() { return timeline.seeks; },
+  get contacts() { return overlays.contacts && structuredClone(overlays.contacts); },
   get camera() { return { position: viewer.camera.position.toArray(), target: viewer.controls.target.toArray() }; },
   get viewDirection() { return viewer.viewDirection().toArray(); },
   /** The energy plot's newest axis ticks: {x, y}, each {values, step, labels}. */

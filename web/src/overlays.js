@@ -1,6 +1,7 @@
-// Client-side overlays on the scene, toggled in the panel: velocity arrows (from the centres of
-// successive drawn states) and short trails. Arrows are triangles (instanced cylinders and
-// cones), so software renderers that draw no GL lines show them too.
+// Overlays on the scene, toggled in the panel: velocity arrows (from the centres of successive
+// drawn states), short trails, and contact points with their normals and impulses (from the
+// stream's contacts messages, docs/protocol.md). Arrows and points are triangles (instanced
+// cylinders, cones and spheres), so software renderers that draw no GL lines show them too.
 import * as THREE from 'three';
 
 /** Most bodies given an arrow (the fastest first), and a trail. */
@@ -15,6 +16,12 @@ const kMinSpeed = 0.05;
 const kTrailSamples = 48;
 const kArrowColor = 0x5ad1ff;
 const kTrailColor = 0xffe08a;
+/** Most contact points drawn. */
+const kMaxContacts = 4096;
+const kContactColor = 0xff3b6b;
+/** Radius of a contact point's dot, m; a normal's length is kNormalMetres × impulse / the largest. */
+const kContactRadius = 0.06;
+const kNormalMetres = 0.8;
 
 export class Overlays {
   /** @param {import('./viewer.js').Viewer} viewer */
@@ -43,6 +50,53 @@ export class Overlays {
     this.trails.visible = false;
     viewer.scene.add(this.trails);
     this.history = new Map(); // body → [x, y, z, …] newest last
+
+    const contactMaterial = new THREE.MeshBasicMaterial({ color: kContactColor, depthTest: false, transparent: true });
+    this.contactDots = new THREE.InstancedMesh(new THREE.SphereGeometry(1, 10, 6), contactMaterial, kMaxContacts);
+    this.contactNormals = new THREE.InstancedMesh(new THREE.CylinderGeometry(1, 1, 1, 6).translate(0, 0.5, 0), contactMaterial, kMaxContacts);
+    for (const mesh of [this.contactDots, this.contactNormals]) {
+      mesh.count = 0;
+      mesh.frustumCulled = false;
+      mesh.visible = false;
+      mesh.renderOrder = 5; // over the boxes: a contact is mostly inside or under one
+      viewer.scene.add(mesh);
+    }
+    this.contactsOn = false;
+    this.contacts = null; // the newest contacts message shown: {step, points}
+  }
+
+  /** Shows or hides the contact points (the page asks the stream for them only while shown). */
+  setContacts(on) {
+    this.contactsOn = on;
+    this.contactDots.visible = this.contactNormals.visible = on;
+    if (!on) this.contacts = null;
+  }
+
+  /**
+   * Draws a contacts message: `points` as [x, y, z, nx, ny, nz, impulse] (m, unit normal, N·s):
+   * a dot at each point and a normal whose length grows with the impulse (the largest of the
+   * message gets kNormalMetres).
+   */
+  showContacts({ step, points }) {
+    if (!this.contactsOn || !Array.isArray(points)) return;
+    this.contacts = { step, points };
+    const m = new THREE.Matrix4(), q = new THREE.Quaternion(), up = new THREE.Vector3(0, 1, 0);
+    const at = new THREE.Vector3(), n = new THREE.Vector3(), s = new THREE.Vector3();
+    const largest = Math.max(1e-12, ...points.map((p) => Math.abs(p[6] ?? 0)));
+    let count = 0;
+    for (const p of points) {
+      if (count >= kMaxContacts || p.length < 6 || !p.every(Number.isFinite)) continue;
+      at.set(p[0], p[1], p[2]);
+      this.contactDots.setMatrixAt(count, m.compose(at, q.identity(), s.setScalar(kContactRadius)));
+      n.set(p[3], p[4], p[5]);
+      if (n.lengthSq() > 0) n.normalize(); else n.copy(up);
+      q.setFromUnitVectors(up, n);
+      const length = Math.max(0.05, (kNormalMetres * Math.abs(p[6] ?? 0)) / largest);
+      this.contactNormals.setMatrixAt(count, m.compose(at, q, s.set(0.015, length, 0.015)));
+      count++;
+    }
+    this.contactDots.count = this.contactNormals.count = count;
+    this.contactDots.instanceMatrix.needsUpdate = this.contactNormals.instanceMatrix.needsUpdate = true;
   }
 
   /** Forgets what was measured (a new scene). */
@@ -52,6 +106,8 @@ export class Overlays {
     this.history.clear();
     this.shafts.count = this.heads.count = 0;
     this.trails.geometry.setDrawRange(0, 0);
+    this.contactDots.count = this.contactNormals.count = 0;
+    this.contacts = null;
   }
 
   /** Shows or hides the velocity arrows. */

@@ -4,7 +4,9 @@
 // newest state when it can; the server's pace follows what this worker received.
 //
 // Messages from the page: {type: 'start', url}, {type: 'pull'} (only when not cross-origin
-// isolated: asks for a copy of the state). To the page: {type: 'scene', message},
+// isolated: asks for a copy of the state), {type: 'subscribe', what, on} (an opt-in stream such
+// as contacts, kept across reconnects). To the page: {type: 'scene', message},
+// {type: 'message', message} (contacts and other text messages),
 // {type: 'status', message}, {type: 'connection', state, detail, connects},
 // {type: 'buffers', buffers} (a new state, shared or copied), {type: 'error', message}.
 import { StreamConnection } from './connection.js';
@@ -53,6 +55,9 @@ function start(url) {
       postMessage({ type: 'status', message });
     },
     onFrame: applyFrame,
+    onMessage(message) {
+      postMessage({ type: 'message', message });
+    },
     onState(state, detail) {
       postMessage({ type: 'connection', state, detail, connects: connection.connects });
     },
@@ -65,6 +70,7 @@ function start(url) {
 
 self.onmessage = ({ data }) => {
   if (data?.type === 'start') start(data.url);
+  else if (data?.type === 'subscribe' && connection) connection.subscribe(data.what, data.on);
   else if (data?.type === 'pull' && writer && !shared) {
     counters();
     if (writer.seq === sentSeq) return;

@@ -5,9 +5,10 @@ import { CanvasRecorder, captureName, download, screenshot } from './capture.js'
 export class ViewMenu {
   /**
    * @param {import('lil-gui').GUI} folder the panel's View folder
-   * @param {{viewer, overlays, inspector, sceneDrop, hud, sceneName: () => string, simTime: () => number}} parts
+   * @param {{viewer, overlays, inspector, sceneDrop, hud, sceneName: () => string, simTime: () => number,
+   *   subscribe: (what: string, on: boolean) => void}} parts
    */
-  constructor(folder, { viewer, overlays, inspector, sceneDrop, hud, sceneName, simTime }) {
+  constructor(folder, { viewer, overlays, inspector, sceneDrop, hud, sceneName, simTime, subscribe }) {
     this.viewer = viewer;
     this.inspector = inspector;
     this.hud = hud;
@@ -18,6 +19,7 @@ export class ViewMenu {
     this.params = {
       velocity: false,
       trails: false,
+      contacts: false,
       inspect: false,
       screenshot: () => this.screenshot(),
       record: () => this.toggleRecording(),
@@ -25,6 +27,10 @@ export class ViewMenu {
     };
     folder.add(this.params, 'velocity').name('velocity arrows').onChange((on) => overlays.setVelocity(on));
     folder.add(this.params, 'trails').name('trails').onChange((on) => overlays.setTrails(on));
+    folder.add(this.params, 'contacts').name('contacts').onChange((on) => {
+      overlays.setContacts(on);
+      subscribe('contacts', on); // the server sends contact points only to viewers that ask
+    });
     folder.add(this.params, 'inspect').name('click inspects');
     folder.add(this.params, 'screenshot').name('Screenshot (PNG)');
     this.recordButton = folder.add(this.params, 'record').name('Record (WebM)');
