@@ -10,7 +10,7 @@ import { WorldMenu } from './world_menu.js';
 
 export const kIntegrators = ['euler', 'midpoint', 'rk4', 'symplectic_euler', 'splitting', 'exact'];
 
-/** A pointer that moves less than this (px) between down and up is a click, not an orbit. */
+/** A press on a box that moves less than this (px) before it is released is a click (a kick), not an aim. */
 const kClickSlopPx = 6;
 /** A press held still this long on a box inspects it instead of kicking, ms. */
 const kLongPressMs = 650;
