@@ -31,7 +31,7 @@ export class Controls {
     this.paused = false;
     this.sceneNames = [];
     this.params = {
-      toggle: () => this.#run(this.paused ? api.resume() : api.pause(), (r) => this.setPaused(r.paused)),
+      toggle: () => this.#run(this.paused ? this.resume() : api.pause(), (r) => this.setPaused(r.paused)),
       step: () => this.#run(api.step(this.params.steps)),
       steps: 1,
       reset: () => this.#run(api.reset()),
@@ -46,6 +46,9 @@ export class Controls {
     this.onInspect = () => {}; // set by main.js: (body index) → show it in the inspector
     this.inspectOnClick = () => false; // …and whether a click inspects rather than kicks
     this.extraShortcuts = {}; // more key → action pairs (main.js)
+    // What Resume (and space) sends: main.js makes it a playback while the timeline shows the
+    // past, so that it never discards the recorded future by accident.
+    this.resume = () => api.resume();
     this.#buildPanel();
     this.#bindPointer(viewer.renderer.domElement);
     this.#bindKeys();

@@ -35,6 +35,7 @@ const viewMenu = new ViewMenu(controls.viewFolder, {
   subscribe: (what, on) => worker.postMessage({ type: 'subscribe', what, on }),
 });
 controls.onInspect = (i) => inspector.show(i);
+controls.resume = () => (timeline.inPast ? api.play(timeline.speed) : api.resume());
 controls.inspectOnClick = () => viewMenu.inspectOnClick;
 inspector.onFollow = (i) => viewer.follow(i);
 controls.extraShortcuts = { p: () => viewMenu.screenshot(), Escape: () => { inspector.show(-1); viewer.follow(-1); } };

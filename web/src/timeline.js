@@ -70,6 +70,16 @@ export class Timeline {
     this.timer = setTimeout(() => this.refresh(), this.enabled ? next : Math.max(next, kRetryMs));
   }
 
+  /** True while the world shows a past step (a timeline that is not live). */
+  get inPast() {
+    return Boolean(this.history && !this.history.live);
+  }
+
+  /** The speed chosen in the bar's menu. */
+  get speed() {
+    return Number(this.speedMenu.value);
+  }
+
   /** Takes the timeline fields of a status message (live, playing, speed, paused, time). */
   onStatus(status) {
     if (!this.history || status.live === undefined) return;
