@@ -92,29 +92,43 @@ test('timeline: drag back 3 s shows the past exactly, resume from there; contact
       assert.ok(Math.hypot(...now.bodies[0].position.map((x, k) => x - then.bodies[0].position[k])) > 0.05
         || Math.hypot(...now.bodies[0].velocity.map((x, k) => x - then.bodies[0].velocity[k])) > 0.05, 'the box moved on since');
 
-      // Drag the slider's thumb to where `then` lies on the track.
+      // Drag the slider's thumb to where `then` lies on the track. Pressing the track half a
+      // second back seeks there, which pauses the world: the range then stands still.
       await until('the bar to know the new range', () => page.evaluate((t0) => window.tumble.timeline?.to.time > t0 + 3, then.time));
       const slider = page.locator('#timeline input[type="range"]');
-      const box = await slider.boundingBox();
-      const { from, to } = await page.evaluate(() => window.tumble.timeline);
-      assert.ok(from.time <= then.time, `the timeline reaches back to ${then.time} s (from ${from.time} s)`);
-      const thumb = 8; // px: half the thumb; a range input maps value to [left + thumb, right − thumb]
-      const xOf = (time) => box.x + thumb + ((time - from.time) / (to.time - from.time)) * (box.width - 2 * thumb);
-      const seeksBefore = await page.evaluate(() => window.tumble.seeks);
-      await page.mouse.move(xOf(to.time), box.y + box.height / 2);
+      const thumb = 8; // px: half the thumb; a range input maps [min, max] to [left + thumb, right − thumb]
+      const track = async () => {
+        const box = await slider.boundingBox();
+        const { from, to } = await page.evaluate(() => window.tumble.timeline);
+        return { box, from, to, xOf: (time) => box.x + thumb + ((time - from.time) / (to.time - from.time)) * (box.width - 2 * thumb) };
+      };
+      const idle = (what, n) => until(what, () => page.evaluate((k) => window.tumble.timelineChanges >= k && !window.tumble.seeking, n), 30000);
+      let { box, from, to, xOf } = await track();
+      const changes = await page.evaluate(() => window.tumble.timelineChanges);
+      await page.mouse.move(xOf(to.time - 0.5), box.y + box.height / 2); // the track, just left of the thumb
       await page.mouse.down();
-      await page.mouse.move(xOf((then.time + to.time) / 2), box.y + box.height / 2, { steps: 5 });
-      await page.mouse.move(xOf(then.time), box.y + box.height / 2, { steps: 5 });
+      await until('the press to pause the world on a past step', async () => (await get('state')).paused, 10000);
+      await idle('the press\'s seek', changes);
+      ({ box, from, to, xOf } = await track());
+      assert.ok(from.time <= then.time, `the timeline reaches back to ${then.time} s (from ${from.time} s)`);
+      await page.mouse.move(xOf((then.time + to.time) / 2), box.y + box.height / 2, { steps: 4 });
+      await page.mouse.move(xOf(then.time), box.y + box.height / 2, { steps: 4 });
       await page.mouse.up();
-      await until('the seeks to be answered', () => page.evaluate((n) => window.tumble.seeks > n, seeksBefore));
+      await idle('the drag to end and its seeks to be answered', changes + 1);
       // Then step by step with the arrow keys (one step each) onto `then`'s exact step.
-      for (let tries = 0; tries < 60; tries++) {
-        await until('no seek in flight', async () => (await get('state')).paused);
+      const startedAt = (await get('state')).step;
+      t.diagnostic(`the drag left the world at step ${startedAt}; the step wanted is ${then.step}`);
+      for (let tries = 0; tries < 30; tries++) {
         const shown = await get('state');
         if (shown.step === then.step) break;
         await slider.focus();
+        const n = await page.evaluate(() => window.tumble.timelineChanges);
         await page.keyboard.press(shown.step > then.step ? 'ArrowLeft' : 'ArrowRight');
-        await until('the arrow key\'s seek', async () => (await get('state')).step !== shown.step, 5000);
+        await idle('the arrow key\'s seek', n + 1)
+          .catch(async (e) => {
+            const detail = await slider.evaluate((el) => `${el.min}..${el.max} step ${el.step} value ${el.value} focused ${document.activeElement === el}`);
+            throw new Error(`${e.message}; at step ${shown.step}, want ${then.step}; slider ${detail}`);
+          });
       }
       const back = await get('state');
       assert.equal(back.step, then.step, 'the world shows the step it was at then');

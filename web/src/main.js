@@ -191,6 +191,8 @@ window.tumble = Object.freeze({
   get sceneError() { return sceneDrop.lastError; },
   get timeline() { return timeline.history && structuredClone(timeline.history); },
   get seeks() { return timeline.seeks; },
+  get seeking() { return timeline.seeking !== null; },
+  get timelineChanges() { return timeline.changes; },
   get contacts() { return overlays.contacts && structuredClone(overlays.contacts); },
   get camera() { return { position: viewer.camera.position.toArray(), target: viewer.controls.target.toArray() }; },
   get viewDirection() { return viewer.viewDirection().toArray(); },

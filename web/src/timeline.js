@@ -27,6 +27,7 @@ export class Timeline {
     this.seeking = null;  // promise of the seek in flight
     this.wanted = null;   // time to seek to once it returns, s
     this.seeks = 0;       // seeks answered
+    this.changes = 0;     // drags and key presses the slider finished
     this.timer = 0;
     this.slider = bar.querySelector('input[type="range"]');
     this.playButton = bar.querySelector('[data-action="play"]');
@@ -40,8 +41,10 @@ export class Timeline {
     this.slider.addEventListener('pointerdown', () => { this.dragging = true; });
     this.slider.addEventListener('input', () => this.seek(Number(this.slider.value)));
     this.slider.addEventListener('change', () => {
+      // After a drag the keys go back to the shortcuts; arrow keys keep the focus for more steps.
+      if (this.dragging) this.slider.blur();
       this.dragging = false;
-      this.slider.blur();
+      this.changes += 1;
       this.seek(Number(this.slider.value));
     });
     this.playButton.addEventListener('click', () => this.togglePlay());
