@@ -10,6 +10,7 @@ export class AddBoxMenu {
   constructor(gui, hud) {
     this.hud = hud;
     this.added = 0; // boxes the server took from this page
+    this.lastError = null; // {status, error, field} of the newest refusal
     this.params = {
       sx: 1, sy: 1, sz: 1, mass: 1, x: 0, y: 4, z: 0, vx: 0, vy: 0, vz: 0,
       color: '#4cc38a',
@@ -44,6 +45,7 @@ export class AddBoxMenu {
       this.hud.toast('box added', 'info');
       return true;
     } catch (e) {
+      this.lastError = { status: e.status, error: e.message, field: e.field };
       this.hud.toast(`add box: ${e.message}${e.field ? ` (${e.field})` : ''}`);
       return false;
     } finally {

@@ -193,6 +193,8 @@ window.tumble = Object.freeze({
   get seeks() { return timeline.seeks; },
   get seeking() { return timeline.seeking !== null; },
   get timelineChanges() { return timeline.changes; },
+  get boxesAdded() { return controls.addBox.added; },
+  get addBoxError() { return controls.addBox.lastError; },
   get contacts() { return overlays.contacts && structuredClone(overlays.contacts); },
   get camera() { return { position: viewer.camera.position.toArray(), target: viewer.controls.target.toArray() }; },
   get viewDirection() { return viewer.viewDirection().toArray(); },
