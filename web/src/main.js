@@ -69,7 +69,8 @@ const handlers = {
     viewer.setScene(message, { refit: name !== currentScene });
     overlays.clear();
     inspector.show(-1);
-    caption.show(message.scene?.description || sceneDrop.descriptionOf(name));
+    // A new scene (not a reset of the same one, nor a box added to it) shows its description.
+    if (name !== currentScene) caption.show(message.scene?.description || sceneDrop.descriptionOf(name));
     currentScene = name;
     state = null;
     drawnFrame = null;
