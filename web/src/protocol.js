@@ -166,8 +166,8 @@ export class BodyStates {
 }
 
 /**
- * Parses a text message: `{"type": "scene"}` gives the scene below, `{"type": "status"}` is
- * returned as sent (with type); anything else returns null.
+ * Parses a text message: `{"type": "scene"}` gives the scene below, `{"type": "status"}` and
+ * `{"type": "contacts"}` are returned as sent (with type); anything else returns null.
  * @param {string} text
  * @returns {null | {type: 'scene', scene: object, faces: number[][], bodies: {name: string, size: number[], color: string}[]}
  *   | {type: 'status', time: number, step: number, paused: boolean, real_time_factor: number,
@@ -175,7 +175,7 @@ export class BodyStates {
  */
 export function parseTextMessage(text) {
   const msg = JSON.parse(text);
-  if (msg?.type === 'status') return msg;
+  if (msg?.type === 'status' || msg?.type === 'contacts') return msg;
   if (!msg || msg.type !== 'scene') return null;
   const scene = msg.scene ?? {};
   const bodies = Array.isArray(msg.bodies) ? msg.bodies
