@@ -64,6 +64,7 @@ std::optional<ToiMethod> parse_toi_method(std::string_view name) {
 
 std::optional<SceneError> validate(const Scene& scene) {
   const WorldDef& w = scene.world;
+  if (w.description.size() > 4096) return SceneError{"description", "at most 4096 bytes"};
   if (!finite(w.gravity) || (w.gravity.array().abs() > 1e4).any())
     return SceneError{"gravity", "must be finite and within 1e4 m/s²"};
   if (!std::isfinite(w.dt) || w.dt <= 0.0 || w.dt > 1.0)

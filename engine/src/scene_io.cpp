@@ -71,6 +71,7 @@ Scene scene_from_json(const json& j) {
   Scene scene;
   WorldDef& w = scene.world;
   if (j.contains("name")) w.name = text(j["name"], "name");
+  if (j.contains("description")) w.description = text(j["description"], "description");
   if (j.contains("gravity")) w.gravity = vec3(j["gravity"], "gravity");
   if (j.contains("floor")) {
     const json& f = j["floor"];
@@ -116,6 +117,7 @@ json scene_to_json(const Scene& scene) {
   auto arr = [](const Vec3& v) { return json::array({v.x(), v.y(), v.z()}); };
   json j;
   j["name"] = w.name;
+  if (!w.description.empty()) j["description"] = w.description;
   j["gravity"] = arr(w.gravity);
   j["floor"] = w.floor ? json{{"height", w.floor->height},
                               {"restitution", w.floor->restitution},

@@ -26,6 +26,9 @@ TEST(SceneIo, EveryBundledSceneLoadsAndRoundTrips) {
     const Scene again = scene_from_json(scene_to_json(scene));
     EXPECT_EQ(scene_to_json(again), scene_to_json(scene)) << name;
   }
+  // The description travels with the scene (the viewer shows it when the scene loads).
+  EXPECT_NE(scene_to_json(load_scene("pyramid_large")).value("description", "").find("5050"),
+            std::string::npos);
   const Scene seed = load_scene("seed");
   EXPECT_EQ(seed.world.integrator, Integrator::midpoint);
   EXPECT_EQ(seed.world.toi, ToiMethod::bisection);
@@ -51,6 +54,9 @@ TEST(SceneIo, BadScenesNameTheField) {
   EXPECT_EQ(field_of(R"({"floor": {"friction": "x"}, "bodies": []})"), "floor.friction");
   EXPECT_EQ(field_of(R"({"gravity": [0, -9.81], "bodies": []})"), "gravity");
   EXPECT_EQ(field_of(R"({"bodies": 3})"), "bodies");
+  EXPECT_EQ(field_of(R"({"description": 7, "bodies": []})"), "description");
+  EXPECT_EQ(field_of(R"({"description": ")" + std::string(4097, 'x') + R"(", "bodies": []})"),
+            "description");
   EXPECT_EQ(field_of(R"([1, 2])"), "");
   EXPECT_EQ(field_of(R"({"floor": null, "bodies": []})"), "<accepted>");
   json many = {{"bodies", json::array()}};

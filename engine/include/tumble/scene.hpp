@@ -50,6 +50,7 @@ struct Floor {
 /// World-wide settings of a scene.
 struct WorldDef {
   std::string name = "untitled";              ///< Scene name.
+  std::string description;                    ///< What the scene shows (≤ 4 KiB; "" for none).
   Vec3 gravity{0.0, -9.81, 0.0};              ///< m/s².
   std::optional<Floor> floor = Floor{};       ///< nullopt: no floor.
   double dt = 1.0 / 60.0;                     ///< Physics step, s.
