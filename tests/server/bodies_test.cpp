@@ -9,6 +9,7 @@
 
 #include "child_process.hpp"
 #include "server_fixture.hpp"
+#include "world_api_test_base.hpp"
 
 namespace tumble::server::test {
 namespace {
@@ -16,29 +17,11 @@ namespace {
 using namespace std::chrono_literals;
 using nlohmann::json;
 
-class BodiesTest : public ServerTest {
+class BodiesTest : public WorldApiTest {
  protected:
   Scene initial_scene() override { return load_scene("resting"); }
   void configure(ServerOptions& o) override { o.read_budget = 0; }
 
-  static std::string prefix(const std::string& world) {
-    return world == "default" ? "/api" : "/api/worlds/" + world;
-  }
-  HttpReply post(const std::string& world, const std::string& route, const std::string& body = {}) {
-    std::map<std::string, std::string> headers;
-    if (tokens_.count(world)) headers["Authorization"] = "Bearer " + tokens_[world];
-    return http_post(port_, prefix(world) + "/" + route, body, headers);
-  }
-  json ok(const std::string& world, const std::string& route, const std::string& body = {}) {
-    const HttpReply r = post(world, route, body);
-    EXPECT_EQ(r.status, 200u) << route << ' ' << body << ": " << r.body;
-    return r.json();
-  }
-  json get(const std::string& world, const std::string& route) {
-    const HttpReply r = http_get(port_, prefix(world) + "/" + route);
-    EXPECT_EQ(r.status, 200u) << route << ": " << r.body;
-    return r.json();
-  }
   /// Adds a body, expecting 201.
   json add(const std::string& world, const json& body) {
     const HttpReply r = post(world, "bodies", body.dump());
@@ -83,7 +66,6 @@ class BodiesTest : public ServerTest {
     return {sim.wait(), out};
   }
 
-  std::map<std::string, std::string> tokens_;
 };
 
 TEST_F(BodiesTest, AnAddedBodyIsListedFallsAndLands) {

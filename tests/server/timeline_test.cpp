@@ -15,6 +15,7 @@
 
 #include "child_process.hpp"
 #include "server_fixture.hpp"
+#include "world_api_test_base.hpp"
 #include "timeline.hpp"
 
 namespace tumble::server::test {
@@ -185,29 +186,11 @@ TEST(Timeline, CheckpointEstimateCoversTheHeapACopyTakes) {
 
 // ---- Through the server ---------------------------------------------------------------
 
-class TimelineServerTest : public ServerTest {
+class TimelineServerTest : public WorldApiTest {
  protected:
   Scene initial_scene() override { return load_scene("dominoes"); }
   void configure(ServerOptions& o) override { o.read_budget = 0; }
 
-  static std::string prefix(const std::string& world) {
-    return world == "default" ? "/api" : "/api/worlds/" + world;
-  }
-  HttpReply post(const std::string& world, const std::string& route, const std::string& body = {}) {
-    std::map<std::string, std::string> headers;
-    if (tokens_.count(world)) headers["Authorization"] = "Bearer " + tokens_[world];
-    return http_post(port_, prefix(world) + "/" + route, body, headers);
-  }
-  json ok(const std::string& world, const std::string& route, const std::string& body = {}) {
-    const HttpReply r = post(world, route, body);
-    EXPECT_EQ(r.status, 200u) << route << ' ' << body << ": " << r.body;
-    return r.json();
-  }
-  json get(const std::string& world, const std::string& route) {
-    const HttpReply r = http_get(port_, prefix(world) + "/" + route);
-    EXPECT_EQ(r.status, 200u) << route << ": " << r.body;
-    return r.json();
-  }
   /// Steps `n` steps exactly (POST step may stop at its budget: it is repeated).
   void step(const std::string& world, std::uint64_t n) {
     const std::uint64_t target = get(world, "state")["step"].get<std::uint64_t>() + n;
@@ -240,7 +223,6 @@ class TimelineServerTest : public ServerTest {
     return json{{"body", body}, {"impulse", {0.3, y, -0.2}}, {"point", {0.0, 1.0, 0.1}}}.dump();
   }
 
-  std::map<std::string, std::string> tokens_;
 };
 
 TEST_F(TimelineServerTest, SeekShowsExactlyTheStraightRun) {
