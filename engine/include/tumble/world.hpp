@@ -122,7 +122,7 @@ class World {
   std::size_t frozen_count() const;
   /// The contact points of the last step (cleared first): the solved contacts of touching
   /// bodies (points within 0.1 mm or pushing), then the floor points of every other body that
-  /// touches the floor (within 1e-6 m). O(bodies); allocates only to grow `out`.
+  /// touches the floor (within 1e-6 m). O(bodies); allocates a flag per body and grows `out`.
   void contacts(std::vector<ContactView>& out) const;
   /// Adds a body (awake) to the running world and returns its id (the next index); time, steps
   /// and every other body's state are kept, and the same additions give the same results.
