@@ -37,10 +37,13 @@ void flight(StepContext& ctx) {
   });
   // A lone body flies with the scene's integrator, its floor impacts found at their time of
   // impact and resting contact handled exactly (floor_contact.cpp).
+  // Each lone body's start state is kept for finalize here, where it is read anyway.
+  BodyState* before = s.before.data() + s.solver_bodies.size();
   ctx.pool.for_each(s.lone_bodies.size(), kLoneGrain, [&](std::size_t begin, std::size_t end) {
     std::uint32_t impacts = 0, iterations = 0;
     for (std::size_t k = begin; k < end; ++k) {
       Body& b = ctx.bodies[s.lone_bodies[k]];
+      before[k] = b.s;
       const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt);
       impacts += static_cast<std::uint32_t>(r.impacts);
       iterations += static_cast<std::uint32_t>(r.toi_iterations);

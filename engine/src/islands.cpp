@@ -81,8 +81,10 @@ void islands(StepContext& ctx) {
   }
   s.stepped = s.solver_bodies;
   s.stepped.insert(s.stepped.end(), s.lone_bodies.begin(), s.lone_bodies.end());
+  // The island bodies' start states; flight keeps the lone bodies' as it reads them (one pass
+  // over their states instead of two).
   s.before.resize(s.stepped.size());
-  ctx.pool.for_each(s.stepped.size(), 1024, [&](std::size_t begin, std::size_t end) {
+  ctx.pool.for_each(s.solver_bodies.size(), 1024, [&](std::size_t begin, std::size_t end) {
     for (std::size_t k = begin; k < end; ++k) s.before[k] = ctx.bodies[s.stepped[k]].s;
   });
   ctx.stats.islands = static_cast<std::uint32_t>(s.island.count());

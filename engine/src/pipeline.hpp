@@ -103,7 +103,8 @@ void broad_phase(StepContext& ctx);
 /// manifolds of the bodies in those contacts.
 void narrow_phase(StepContext& ctx);
 /// Stage: islands of touching bodies (scratch.solver_bodies); every other awake body is an
-/// island of one (scratch.lone_bodies); start states kept for finalize (scratch.before).
+/// island of one (scratch.lone_bodies); the island bodies' start states kept for finalize
+/// (scratch.before; flight keeps the lone bodies').
 void islands(StepContext& ctx);
 /// Stage: impulses of the islands' contacts; leaves the islands' momenta at the end of the
 /// step and their split-impulse pseudo velocities in scratch.solver.

@@ -175,7 +175,10 @@ TEST(Stack, TowerSleepsAsOneIslandAndAFallingBoxWakesIt) {
   }
   ASSERT_GE(woke_at, 0) << "the falling box should wake the whole tower through its top box";
   EXPECT_GT(world.last_step().solver_bodies, 10u);
-  for (int i = 0; i < 600; ++i) world.step();
+  // The hit tower rocks for seconds (a slender column loses little energy per rock: Housner
+  // 1963), and when it settles is chaotic: all asleep at 10.4 s of simulated time in one
+  // build, at 12.2 s after a change of rounding in a cube's ω. The wait allows about 16 s.
+  for (int i = 0; i < 900; ++i) world.step();
   EXPECT_EQ(world.awake_count(), 0u);  // everything asleep again
   // A 1 kg box landing at 24 m/s shakes the tower but it stays standing.
   EXPECT_LT((world.body(0).s.x - bottom.x).norm(), 1e-2);
