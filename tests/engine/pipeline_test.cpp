@@ -5,6 +5,7 @@
 #include <cstring>
 #include <new>
 
+#include "../sanitized.hpp"
 #include "world_fixture.hpp"
 
 // ThreadSanitizer's runtime defines the global operator new itself: there the allocation
@@ -80,7 +81,9 @@ TEST(Pipeline, StageTimesOnlyWhenAskedFor) {
 // A copy starts without the broad-phase acceleration and the scratch buffers; the results do
 // not depend on them, so the copy and the original stay bit-identical.
 TEST(Pipeline, CopyWithoutCachesContinuesBitForBit) {
-  World a(bundled("pile"));
+  Scene pile = bundled("pile");
+  pile.bodies.resize(testing::kPileBodies);
+  World a(pile);
   for (int i = 0; i < 45; ++i) a.step();
   World b = a;
   for (int i = 0; i < 45; ++i) {

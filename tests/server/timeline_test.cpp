@@ -13,6 +13,7 @@
 #include <functional>
 #include <thread>
 
+#include "../sanitized.hpp"
 #include "child_process.hpp"
 #include "server_fixture.hpp"
 #include "world_api_test_base.hpp"
@@ -150,7 +151,9 @@ TEST(Timeline, DiscardFutureForgetsLaterCommands) {
 // A recording's JSON (scene with random orientations, impulses at points) reads back to the
 // same run: the replay ends on the live world's digest.
 TEST(Timeline, RecordingJsonRoundTripsToTheSameDigest) {
-  World live(load_scene("pile"));
+  Scene pile = load_scene("pile");
+  pile.bodies.resize(tumble::testing::kPileBodies);
+  World live(pile);
   Timeline timeline({60.0, 256u << 20});
   timeline.restart(live, "pile");
   record(timeline, live, 90);
