@@ -63,6 +63,15 @@ inline NormalSystem make_normal_system(const Vec3& n, const Vec3& t1, const Vec3
   return sys;
 }
 
+/// W_r (V_rᵀ S V_r)⁻¹ W_rᵀ over the first R columns of V and W (R = 1, 2, 3).
+template <int R>
+Mat3 reduced_pseudo_inverse(const Mat3& V, const Mat3& W, const Mat3& S) {
+  const Eigen::Matrix<double, 3, R> Vr = V.template leftCols<R>();
+  const Eigen::Matrix<double, 3, R> Wr = W.template leftCols<R>();
+  const Eigen::Matrix<double, R, R> T = Vr.transpose() * S * Vr;
+  return Wr * T.inverse() * Wr.transpose();
+}
+
 /// P with K⁺ = D P Dᵀ for K = D S Dᵀ (S symmetric positive definite): closed form when the
 /// points span the plane, else through the eigendecomposition of D's Gram matrix G = DᵀD with
 /// its columns scaled to unit length, dropping directions below 1e-6 of the largest.
@@ -93,9 +102,10 @@ inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   Eigen::SelfAdjointEigenSolver<Mat3> eig(Gn);
   const Vec3 lambda = eig.eigenvalues();
   const double cutoff = kRank * lambda.cwiseAbs().maxCoeff();
-  // Keep the directions D̂ spans: W = V_r Λ_r⁻¹, then P̂ = W (V_rᵀ Ŝ V_r)⁻¹ Wᵀ.
-  using Basis = Eigen::Matrix<double, 3, Eigen::Dynamic, 0, 3, 3>;
-  Basis V(3, 3), W(3, 3);
+  // Keep the directions D̂ spans: W = V_r Λ_r⁻¹, then P̂ = W (V_rᵀ Ŝ V_r)⁻¹ Wᵀ, with r × r
+  // matrices of a fixed size (closed-form inverses; the dynamic-size inverse went through a
+  // general LU, a fifth of this function on a landing's edge contacts).
+  Mat3 V = Mat3::Zero(), W = Mat3::Zero();
   int r = 0;
   for (int k = 0; k < 3; ++k) {
     if (lambda(k) <= cutoff) continue;
@@ -103,12 +113,13 @@ inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
     W.col(r) = eig.eigenvectors().col(k) / lambda(k);
     ++r;
   }
-  if (r == 0) return Mat3::Zero();
-  V.conservativeResize(3, r);
-  W.conservativeResize(3, r);
-  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3, 3> T =
-      V.transpose() * Sn * V;
-  const Mat3 Pn = W * T.inverse() * W.transpose();
+  Mat3 Pn;
+  switch (r) {
+    case 0: return Mat3::Zero();
+    case 1: Pn = reduced_pseudo_inverse<1>(V, W, Sn); break;
+    case 2: Pn = reduced_pseudo_inverse<2>(V, W, Sn); break;
+    default: Pn = reduced_pseudo_inverse<3>(V, W, Sn); break;
+  }
   return inv_norm.asDiagonal() * Pn * inv_norm.asDiagonal();
 }
 
