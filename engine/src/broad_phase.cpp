@@ -257,10 +257,13 @@ std::pair<double, double> parabola_range(double v, double g, double T) {
   return {lo, hi};
 }
 
-/// The box the pairs are cached for: body b's tight box swept along its ballistic path for
-/// kFatSteps steps, grown by half its bounding radius (for turns, impulses and contacts).
+/// The box the pairs are cached for: body b's tight box grown by half its bounding radius
+/// (for turns, impulses and contacts) and, while b touches nothing, swept along its
+/// ballistic path for kFatSteps steps. A body in contact does not fly: stretched along its
+/// fall, its box met more neighbours in a pile, which cost the pile's broad phase half again.
 Aabb fat_box(const Aabb& tight, const Body& b, const Vec3& gravity, double dt) {
   const double margin = 0.5 * b.c.bounding_radius;
+  if (b.in_contact) return {tight.lo.array() - margin, tight.hi.array() + margin};
   const Vec3 v = velocity(b.s, b.c);
   Aabb fat;
   for (int i = 0; i < 3; ++i) {
@@ -272,11 +275,17 @@ Aabb fat_box(const Aabb& tight, const Body& b, const Vec3& gravity, double dt) {
 }
 
 /// Every body's flags and the awake list, after an activity changed (the epoch moved). A
-/// sleeping body does not move: its box is computed once, when it is first seen asleep, and
-/// is its own fat box.
-void rescan(StepContext& ctx) {
+/// sleeping body does not move: its box is computed once, when it is first seen asleep.
+/// Returns whether the cached fat pairs still hold every pair that can touch: so when bodies
+/// only fell asleep (their pairs with awake bodies are cached; the filter drops pairs of two
+/// sleeping ones), each at rest inside the fat box its pairs were found for, which it keeps.
+/// A body that woke, appeared or changed candidacy needs a new sweep. In a settling pile more
+/// than half of the changes are bodies falling asleep, and each one re-swept all 1,000 boxes.
+bool rescan(StepContext& ctx) {
   BroadPhaseCache& k = ctx.broad;
   const std::size_t n = ctx.bodies.size();
+  const std::size_t known = k.active.size();
+  bool pairs_hold = k.fat_valid && known == n;
   k.epoch = ctx.cache.activity_epoch;
   k.boxes.resize(n);
   k.fat.resize(n);
@@ -285,15 +294,20 @@ void rescan(StepContext& ctx) {
   k.candidate.resize(n);
   k.awake.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
+    const bool was_active = i < known && k.active[i];
     k.active[i] = ctx.bodies[i].activity == Activity::awake;
     if (k.active[i]) {
+      pairs_hold = pairs_hold && was_active;
       k.awake.push_back(i);
       continue;
     }
     if (k.box_cached[i]) continue;
-    update_box(ctx, i);
+    const bool changed = update_box(ctx, i);
+    if (was_active && !changed && contains(k.fat[i], k.boxes[i])) continue;
+    pairs_hold = false;
     k.fat[i] = k.boxes[i];
   }
+  return pairs_hold;
 }
 
 }  // namespace
@@ -311,9 +325,9 @@ void broad_phase(StepContext& ctx) {
   s.pairs.clear();
   const std::size_t n = ctx.bodies.size();
   const bool full = k.epoch != ctx.cache.activity_epoch || k.active.size() != n;
-  if (full) rescan(ctx);
+  if (full && !rescan(ctx)) k.fat_valid = false;
   // Each awake body's box on its own, shared among the pool's threads; the flags are ORed.
-  std::atomic<bool> rebuild = full || !k.fat_valid;
+  std::atomic<bool> rebuild = !k.fat_valid;
   ctx.pool.for_each(k.awake.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     bool changed = false;
     for (std::size_t a = begin; a < end; ++a) {
@@ -335,7 +349,8 @@ void broad_phase(StepContext& ctx) {
     k.fat_valid = true;
   }
   for (const BodyPair& p : k.fat_pairs)
-    if (overlaps(k.boxes[p.first], k.boxes[p.second])) s.pairs.push_back(p);
+    if ((k.active[p.first] || k.active[p.second]) && overlaps(k.boxes[p.first], k.boxes[p.second]))
+      s.pairs.push_back(p);
   ctx.stats.pairs = static_cast<std::uint32_t>(s.pairs.size());
   ctx.stats.pair_budget_exceeded = k.fat_complete ? 0 : 1;
 }

@@ -55,7 +55,7 @@ struct BroadPhaseCache {
   std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
   std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
   std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
-  bool fat_valid = false;                ///< fat_pairs was found for the current flags.
+  bool fat_valid = false;                ///< fat_pairs holds every pair that can touch.
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
 };
 
