@@ -55,7 +55,10 @@ struct BroadPhaseCache {
   std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
   std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
   std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
-  bool fat_valid = false;                ///< fat_pairs holds every pair that can touch.
+  bool fat_valid = false;                ///< fat_pairs holds every pair that can touch,
+                                         ///< but those of the bodies in `woken`.
+  std::vector<std::uint32_t> woken;      ///< Bodies woken since fat_pairs was found.
+  std::vector<std::uint8_t> unpaired;    ///< Body is in `woken` (its fat box is stale).
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
 };
 
