@@ -319,7 +319,8 @@ bool rescan(StepContext& ctx) {
 /// Pairs of the woken bodies with every candidate whose fat box meets theirs, merged into
 /// the cached pairs (sorted, each once): the pairs a new sweep would find. Worth it while
 /// woken × bodies overlap tests cost less than a sweep, whose cost grows faster than the
-/// bodies (~6,000 instructions a box in a 3-D pile); returns false, doing nothing, past that.
+/// bodies (~6,000 instructions a box in a 3-D pile). Returns false past that bound or past the
+/// pair budget: the caller then sweeps.
 bool add_woken_pairs(StepContext& ctx) {
   constexpr std::size_t kMaxTests = 1u << 16;
   BroadPhaseCache& k = ctx.broad;
