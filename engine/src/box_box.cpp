@@ -273,36 +273,4 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
   return m;
 }
 
-// Anchors for recycling (Box2D v3.2 keeps a contact's manifold while the pair's relative pose
-// barely moves): each point splits into the point on A's surface and the one on B's, held in
-// their own body's frame, so that the pair's motion moves them as material points.
-void anchor_manifold(BoxManifold& m, const BodyState& a, const BodyState& b) {
-  for (int i = 0; i < m.count; ++i) {
-    ManifoldPoint& p = m.points[i];
-    const Vec3 half = (0.5 * p.separation) * m.normal;
-    p.local_a = a.R.transpose() * (p.position - half - a.x);
-    p.local_b = b.R.transpose() * (p.position + half - b.x);
-  }
-  m.local_normal = a.R.transpose() * m.normal;
-  m.relative_R = a.R.transpose() * b.R;
-  m.relative_x = a.R.transpose() * (b.x - a.x);
-}
-
-bool pose_close(const BoxManifold& m, const BodyState& a, const BodyState& b, double distance,
-                double angle) {
-  const Vec3 x = a.R.transpose() * (b.x - a.x);
-  if ((x - m.relative_x).cwiseAbs().maxCoeff() > distance) return false;
-  return ((a.R.transpose() * b.R) - m.relative_R).cwiseAbs().maxCoeff() <= angle;
-}
-
-void move_manifold(BoxManifold& m, const BodyState& a, const BodyState& b) {
-  m.normal = a.R * m.local_normal;
-  for (int i = 0; i < m.count; ++i) {
-    ManifoldPoint& p = m.points[i];
-    const Vec3 pa = a.x + a.R * p.local_a, pb = b.x + b.R * p.local_b;
-    p.position = 0.5 * (pa + pb);
-    p.separation = (pb - pa).dot(m.normal);
-  }
-}
-
 }  // namespace tumble

@@ -5,11 +5,21 @@
 namespace tumble {
 namespace {
 
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+  return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
 /// Starts each contact from the impulses its pair had last step (matched by key).
 void warm_start(StepContext& ctx) {
-  for (Contact& c : ctx.scratch.contacts)
-    if (const Contact* previous = previous_contact(ctx.cache, c.a, c.b))
-      warm_start_from(c, *previous);
+  const ContactCache& cache = ctx.cache;
+  for (Contact& c : ctx.scratch.contacts) {
+    const std::uint64_t key = pair_key(c.a, c.b);
+    const auto it = std::lower_bound(
+        cache.previous_keys.begin(), cache.previous_keys.end(), key,
+        [](const std::pair<std::uint64_t, std::uint32_t>& e, std::uint64_t k) { return e.first < k; });
+    if (it != cache.previous_keys.end() && it->first == key)
+      warm_start_from(c, cache.previous[it->second]);
+  }
 }
 
 /// Keeps this step's contacts (with their impulses) for the next step's warm start.
@@ -25,15 +35,6 @@ void keep_for_warm_start(StepContext& ctx) {
 }
 
 }  // namespace
-
-const Contact* previous_contact(const ContactCache& cache, std::uint32_t a, std::uint32_t b) {
-  const std::uint64_t key = pair_key(a, b);
-  const auto it = std::lower_bound(
-      cache.previous_keys.begin(), cache.previous_keys.end(), key,
-      [](const std::pair<std::uint64_t, std::uint32_t>& e, std::uint64_t k) { return e.first < k; });
-  return it != cache.previous_keys.end() && it->first == key ? &cache.previous[it->second]
-                                                             : nullptr;
-}
 
 void contact_solve(StepContext& ctx) {
   StepScratch& s = ctx.scratch;

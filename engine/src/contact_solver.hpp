@@ -31,8 +31,6 @@ struct ContactPoint {
   double normal_mass = 0.0;                   ///< 1 / (n·K n), kg.
   std::array<double, 2> tangent_mass{};       ///< 1 / (t·K t), kg.
   double pseudo_impulse = 0.0;                ///< Split-impulse position correction, N·s.
-  // Box–box only: the point on a's surface (a's frame) and on b's (b's frame), m.
-  Vec3 local_a = Vec3::Zero(), local_b = Vec3::Zero();
 };
 
 /// The contact of body a (or the floor, a = kStaticBody) with body b: normal from a to b.
@@ -44,10 +42,6 @@ struct Contact {
   double restitution = 0.0;       ///< e of the pair (applied to impacts only).
   int count = 0;                  ///< Points in use.
   std::array<ContactPoint, kMaxContactPoints> points{};
-  // Box–box only: the pose the manifold was found at (narrow_phase.cpp recycles it).
-  Vec3 local_normal = Vec3::UnitY();   ///< The normal in a's frame.
-  Mat3 relative_R = Mat3::Identity();  ///< aᵀ b then.
-  Vec3 relative_x = Vec3::Zero();      ///< b's centre in a's frame then, m.
 };
 
 /// Tuning of the contact solver.

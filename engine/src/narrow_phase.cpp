@@ -1,5 +1,4 @@
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 
 #include "box_box.hpp"
@@ -38,64 +37,18 @@ Contact contact_of(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const
     c.points[i].position = m.points[i].position;
     c.points[i].separation = m.points[i].separation;
     c.points[i].id = m.points[i].id;
-    c.points[i].local_a = m.points[i].local_a;
-    c.points[i].local_b = m.points[i].local_b;
   }
-  c.local_normal = m.local_normal;
-  c.relative_R = m.relative_R;
-  c.relative_x = m.relative_x;
   return c;
 }
 
-// Manifold recycling (Box2D v3.2's idea): while a pair's relative pose stays within these of
-// the pose its manifold was found at, last step's manifold is moved with the bodies instead
-// of found again. Its points are material points of the two boxes (vertices, and their
-// projections on the reference face), whose separations the move gets exactly; clipped
-// points slide along an incident edge by at most the distance times the edge's tilt. A
-// resting stack moves µm a step, so most of its pairs are recycled (`pyramid` kept awake:
-// 60 % of its manifolds, 6.6 % fewer instructions); a falling pile's are found every step.
-// The bound is what kept the physics: at 2e-4 (the solver's slop) the settling pile jittered
-// and fell asleep at 15.1 s instead of 6.6 s, and the tower hit by a falling box rocked until
-// 23 s instead of 12 s; at 2e-5 they took 8.6 s and 13.1 s; at 1e-5, 6.7 s and 12.2 s.
-// Tower drift (1.1e-10 m in 60 s) and pyramid penetration (1.1e-5 m) are unchanged.
-constexpr double kRecycleDistance = 1e-5;  // m, each coordinate of b's centre in a's frame
-constexpr double kRecycleAngle = 1e-5;     // rad, each entry of aᵀ b
-
-/// Last step's manifold of bodies a, b moved to their poses now, when their relative pose is
-/// within the recycling bounds of the pose it was found at; else count 0.
-BoxManifold recycled(const StepContext& ctx, const BodyPair& p, const Body& a, const Body& b) {
-  BoxManifold m;
-  const Contact* last = previous_contact(ctx.cache, p.first, p.second);
-  if (!last || last->count == 0 || last->count > kMaxManifoldPoints) return m;
-  m.local_normal = last->local_normal;
-  m.relative_R = last->relative_R;
-  m.relative_x = last->relative_x;
-  if (!pose_close(m, a.s, b.s, kRecycleDistance, kRecycleAngle)) return m;
-  m.count = last->count;
-  for (int i = 0; i < m.count; ++i) {
-    m.points[i].id = last->points[i].id;
-    m.points[i].local_a = last->points[i].local_a;
-    m.points[i].local_b = last->points[i].local_b;
-  }
-  move_manifold(m, a.s, b.s);
-  return m;
-}
-
-/// The manifold of pair p, or none (count 0) when its boxes will not touch within the step;
-/// *recycled counts it when it was last step's, moved.
-BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, std::uint32_t* recycled_count) {
+/// The manifold of pair p, or none (count 0) when its boxes will not touch within the step.
+BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p) {
   const Body& a = ctx.bodies[p.first];
   const Body& b = ctx.bodies[p.second];
-  BoxManifold m = recycled(ctx, p, a, b);
-  if (m.count > 0) {
-    ++*recycled_count;
-  } else {
-    const double closing = ctx.dt * ((a.s.P * a.c.inv_mass - b.s.P * b.c.inv_mass).norm() +
-                                     angular_velocity(a.s, a.c).norm() * a.c.bounding_radius +
-                                     angular_velocity(b.s, b.c).norm() * b.c.bounding_radius);
-    m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
-    anchor_manifold(m, a.s, b.s);
-  }
+  const double closing = ctx.dt * ((a.s.P * a.c.inv_mass - b.s.P * b.c.inv_mass).norm() +
+                                   angular_velocity(a.s, a.c).norm() * a.c.bounding_radius +
+                                   angular_velocity(b.s, b.c).norm() * b.c.bounding_radius);
+  BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
   if (m.count > 0 && !touches(m, a, b, ctx.dt)) m.count = 0;
   return m;
 }
@@ -117,10 +70,7 @@ void collide_pairs(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
   s.manifolds.resize(s.pairs.size());
   ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    std::uint32_t recycled_count = 0;
-    for (std::size_t k = begin; k < end; ++k)
-      s.manifolds[k] = manifold_of(ctx, s.pairs[k], &recycled_count);
-    std::atomic_ref(ctx.stats.recycled).fetch_add(recycled_count, std::memory_order_relaxed);
+    for (std::size_t k = begin; k < end; ++k) s.manifolds[k] = manifold_of(ctx, s.pairs[k]);
   });
   const std::uint32_t count = number_slots(s.pairs.size(), s.slot,
                                            [&](std::size_t k) { return s.manifolds[k].count > 0; });

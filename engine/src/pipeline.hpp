@@ -96,14 +96,6 @@ struct StepContext {
   WorkerPool& pool;          ///< Threads for the stages' independent work (1: inline).
 };
 
-/// The key of the contact of bodies a and b in ContactCache::previous_keys.
-inline std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
-  return (static_cast<std::uint64_t>(a) << 32) | b;
-}
-
-/// Last step's contact of bodies a and b, or null.
-const Contact* previous_contact(const ContactCache& cache, std::uint32_t a, std::uint32_t b);
-
 /// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island).
 void init_caches(ContactCache& cache, std::size_t body_count);
 

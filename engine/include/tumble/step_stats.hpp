@@ -36,7 +36,6 @@ struct StepStats {
   std::uint32_t pairs = 0;           ///< Broad-phase pairs whose bounding boxes overlap.
   std::uint32_t contacts = 0;        ///< Body–body contacts (pairs with manifold points).
   std::uint32_t contact_points = 0;  ///< Points in those contacts.
-  std::uint32_t recycled = 0;        ///< Box–box manifolds moved on from the last step.
   std::uint32_t islands = 0;         ///< Islands of touching bodies solved together.
   std::uint32_t solver_bodies = 0;   ///< Bodies stepped by the contact solver.
   std::uint32_t colours = 0;         ///< Colours of the solver's contacts (0 on one thread).
