@@ -25,6 +25,12 @@ struct Aabb {
 Aabb swept_aabb(const BodyState& s, const BodyConstants& c, const Vec3& gravity, double dt,
                 double margin);
 
+/// Whether two boxes overlap (touching counts).
+inline bool overlaps(const Aabb& a, const Aabb& b) {
+  return a.lo.x() <= b.hi.x() && a.lo.y() <= b.hi.y() && a.lo.z() <= b.hi.z() &&
+         b.lo.x() <= a.hi.x() && b.lo.y() <= a.hi.y() && b.lo.z() <= a.hi.z();
+}
+
 /// A candidate pair of body indices, first < second.
 using BodyPair = std::pair<std::uint32_t, std::uint32_t>;
 
