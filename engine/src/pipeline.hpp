@@ -3,7 +3,8 @@
 /// signature, `void stage(StepContext&)`, in a file of its own (MuJoCo's mj_step and Box2D's
 /// b2World_Step as models):
 ///
-///   broad_phase   → broad_phase.cpp   pairs of bodies whose swept boxes overlap
+///   broad_phase   → broad_phase.cpp   pairs of bodies whose swept boxes overlap (the sweep:
+///                                     sweep_and_prune.cpp)
 ///   narrow_phase  → narrow_phase.cpp  box–box manifolds; box–floor manifolds of bodies in them
 ///   islands       → islands.cpp       bodies linked by contacts; a lone body is an island of one
 ///   contact_solve → contact_solver.cpp impacts, friction, non-penetration of the islands
