@@ -46,8 +46,18 @@ struct HalfEdges {
   }
 };
 
-double vertex_y(const BodyState& s, const BodyConstants& c, int i) {
-  return s.x.y() + HalfEdges(s, c).vertex_y(i);
+/// Height of the lowest of the vertices in `mask` (bit i: vertex i), m; +∞ for an empty mask.
+double lowest_masked_y(const BodyState& s, const BodyConstants& c, unsigned mask) {
+  const HalfEdges e(s, c);
+  double lowest = INFINITY;
+  for (int i = 0; i < 8; ++i)
+    if (mask & (1u << i)) lowest = std::min(lowest, s.x.y() + e.vertex_y(i));
+  return lowest;
+}
+
+/// The body's bounding sphere lies wholly above the floor plane y = floor_y.
+bool clear_of_floor(const BodyState& s, const BodyConstants& c, double floor_y) {
+  return s.x.y() - c.bounding_radius > floor_y;
 }
 
 ContactSet touching_vertices(const BodyState& s, const BodyConstants& c, double limit_y) {
@@ -339,11 +349,7 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
   auto height = [&](double t) {
     ++evaluations;
     const BodyState st = advance(w.integrator, s, c, w.gravity, t);
-    if (mask == 0xFF) return lowest_vertex_y(st, c) - floor_y;
-    double lowest = INFINITY;
-    for (int i = 0; i < 8; ++i)
-      if (mask & (1u << i)) lowest = std::min(lowest, vertex_y(st, c, i));
-    return lowest - floor_y;
+    return (mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask)) - floor_y;
   };
   if (w.toi == ToiMethod::bisection) {
     // The seed's search: halve the interval, keeping the last time that does not penetrate.
@@ -414,7 +420,7 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
   for (int k = 0; k < kMaxImpactsPerStep && remaining > 1e-15; ++k) {
     // Bounding sphere clear of the floor at both ends: no vertex test (the flight path's
     // lowest point is at an end while gravity points down).
-    const bool start_clear = s.x.y() - c.bounding_radius > floor_y;
+    const bool start_clear = clear_of_floor(s, c, floor_y);
     if (!start_clear && in_resting_contact(s, c, floor_y, vrest, w.dt)) {
       contact_step(s, c, w.gravity, floor_y, remaining);
       result.touched = true;
@@ -422,7 +428,7 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     }
     const BodyState next =
         k == 0 && flown ? *flown : advance(w.integrator, s, c, w.gravity, remaining);
-    if (next.x.y() - c.bounding_radius > floor_y && (start_clear || w.gravity.y() <= 0.0)) {
+    if (clear_of_floor(next, c, floor_y) && (start_clear || w.gravity.y() <= 0.0)) {
       s = next;
       return result;
     }
@@ -436,12 +442,8 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
       // A vertex that started on the floor ends inside it: resting contact, not an impact.
       break;
     }
-    double masked_end = end_height;
-    if (mask != 0xFF) {
-      masked_end = INFINITY;
-      for (int i = 0; i < 8; ++i)
-        if (mask & (1u << i)) masked_end = std::min(masked_end, vertex_y(next, c, i) - floor_y);
-    }
+    const double masked_end =
+        mask == 0xFF ? end_height : lowest_masked_y(next, c, mask) - floor_y;
     const double t = time_of_impact(s, c, w, floor_y, remaining, mask, masked_end,
                                     result.toi_iterations);
     if (t > 0.0) s = advance(w.integrator, s, c, w.gravity, t);
@@ -470,9 +472,9 @@ FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
     return {};
   }
   const double floor_y = w.floor->height;
-  if (!(s.x.y() - c.bounding_radius > floor_y)) return meet_floor(body, w, dt, nullptr);
+  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr);
   const BodyState next = advance(w.integrator, s, c, w.gravity, dt);
-  if (!(next.x.y() - c.bounding_radius > floor_y)) return meet_floor(body, w, dt, &next);
+  if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next);
   s = next;
   return {};
 }

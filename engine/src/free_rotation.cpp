@@ -163,22 +163,6 @@ struct Jacobi {
   double sn = 0.0, cn = 1.0, dn = 1.0;
 };
 
-// sin x and cos x; below 0.5 rad (every step's turn about L) by their Taylor series to x¹³ and
-// x¹⁴, whose first omitted terms are under 4e-17 and 3e-18 there: a tenth of the library's
-// sincos, no reduction of the argument needed.
-void small_angle_sin_cos(double x, double& s, double& c) {
-  if (!(std::abs(x) < 0.5)) {
-    s = std::sin(x);
-    c = std::cos(x);
-    return;
-  }
-  const double t = x * x;
-  s = x * (1.0 + t * (-1.0 / 6 + t * (1.0 / 120 + t * (-1.0 / 5040 + t * (1.0 / 362880 +
-      t * (-1.0 / 39916800 + t * (1.0 / 6227020800.0)))))));
-  c = 1.0 + t * (-0.5 + t * (1.0 / 24 + t * (-1.0 / 720 + t * (1.0 / 40320 + t * (-1.0 / 3628800 +
-      t * (1.0 / 479001600 + t * (-1.0 / 87178291200.0)))))));
-}
-
 // Carlson's R_C(1, 1 + e) for e > −1: atan(√e)/√e, or atanh(√−e)/√−e (DLMF 19.2.18–19). The
 // duplication below calls it with |e| ~ 1e-9 for a step, where the alternating series
 // Σ (−e)ʲ/(2j + 1) to e⁵ is exact to round-off (its first omitted term is below e⁶/13).

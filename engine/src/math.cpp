@@ -12,26 +12,38 @@ Mat3 skew(const Vec3& a) {
   return m;
 }
 
-// Rodrigues' formula R = I + a K + b K² with K = skew(v), expanded so that no 3×3 product is
-// formed (K² = v vᵀ − |v|² I). a = sin θ/θ and b = (1 − cos θ)/θ² are even functions of θ:
-// below θ = 0.5 rad (every step of a body spinning under 120 rad/s at dt 1/240) their Taylor
-// series in θ² to θ¹² leaves out less than 5e-17, under half an ulp of a ≈ 1 and b ≈ ½, and
-// costs no square root, sine or cosine (the library's sincos was half the cost of a cube's
-// step). The closed form is used above, where it does not cancel.
-Mat3 rotation_from_vector(const Vec3& v) {
-  const double t = v.squaredNorm();
-  double a, b;
+// a = sin θ/θ and b = (1 − cos θ)/θ² are even functions of θ: below θ = 0.5 rad (every step
+// of a body spinning under 120 rad/s at dt 1/240) their Taylor series in θ² to θ¹² leaves out
+// less than 5e-17, under half an ulp of a ≈ 1 and b ≈ ½, and costs no square root, sine or
+// cosine (the library's sincos was half the cost of a cube's step). The closed form is used
+// above, where it does not cancel.
+void sinc_and_versine(double t, double& a, double& b) {
   if (t < 0.25) {
     // (−1)ᵏ/(2k+1)! and (−1)ᵏ/(2k+2)!, k = 0…6, in Horner form.
     a = 1.0 + t * (-1.0 / 6 + t * (1.0 / 120 + t * (-1.0 / 5040 + t * (1.0 / 362880 +
         t * (-1.0 / 39916800 + t * (1.0 / 6227020800 + t * (-1.0 / 1307674368000.0)))))));
     b = 0.5 + t * (-1.0 / 24 + t * (1.0 / 720 + t * (-1.0 / 40320 + t * (1.0 / 3628800 +
         t * (-1.0 / 479001600 + t * (1.0 / 87178291200.0 + t * (-1.0 / 20922789888000.0)))))));
-  } else {
-    const double theta = std::sqrt(t);
-    a = std::sin(theta) / theta;
-    b = (1.0 - std::cos(theta)) / t;
+    return;
   }
+  const double theta = std::sqrt(t);
+  a = std::sin(theta) / theta;
+  b = (1.0 - std::cos(theta)) / t;
+}
+
+void small_angle_sin_cos(double x, double& s, double& c) {
+  double a, b;
+  sinc_and_versine(x * x, a, b);
+  s = a * x;
+  c = 1.0 - b * (x * x);
+}
+
+// Rodrigues' formula R = I + a K + b K² with K = skew(v), expanded so that no 3×3 product is
+// formed (K² = v vᵀ − |v|² I), a and b from sinc_and_versine.
+Mat3 rotation_from_vector(const Vec3& v) {
+  const double t = v.squaredNorm();
+  double a, b;
+  sinc_and_versine(t, a, b);
   const double d = 1.0 - b * t;
   const Vec3 av = a * v;
   const Vec3 bv = b * v;

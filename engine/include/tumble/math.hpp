@@ -15,6 +15,13 @@ Mat3 skew(const Vec3& a);
 /// exp of skew(rotation_vector): a rotation by |v| radians about v (Rodrigues' formula).
 Mat3 rotation_from_vector(const Vec3& rotation_vector);
 
+/// sin θ / θ and (1 − cos θ) / θ² from θ² (rad²), accurate at every angle, with no library
+/// call below θ = 0.5 rad.
+void sinc_and_versine(double theta2, double& sinc, double& versine);
+
+/// sin x and cos x, with no library call below 0.5 rad (a step's small turns).
+void small_angle_sin_cos(double x, double& s, double& c);
+
 /// Rotation by `angle` radians about the principal body axis `axis` (0, 1 or 2).
 Mat3 axis_rotation(int axis, double angle);
 
