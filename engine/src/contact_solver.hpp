@@ -84,13 +84,19 @@ struct PointRows {
   std::array<Vec3, 3> inv_b;  ///< I_b⁻¹ (rb × d_k), 1/(kg·m).
 };
 
-/// A contact's solver data: its directions, its points' rows and K⁺ = D P Dᵀ of its
-/// normal-impulse matrix (active_set.hpp), kept factored: a product with it costs 6m + 9
-/// multiplications instead of m².
+/// A contact's solver data: its directions, its points' rows and its normal block in the
+/// patch's plane coordinates. K⁺ = D P Dᵀ (active_set.hpp); the normal velocities of all points
+/// are vn = D y with y = (normal speed at the patch origin, the two tipping rates), and an
+/// impulse Δλ = D z moves the bodies by the patch wrench u = G z, G = DᵀD: a block iteration
+/// works on 3-vectors whatever the number of points.
 struct ContactRows {
   std::array<Vec3, 3> dir;  ///< n, t1, t2 (unit, world).
   PlaneCoordinates D;       ///< (1, α, β) of each point.
-  Mat3 P = Mat3::Zero();    ///< The 3×3 middle factor.
+  Mat3 G = Mat3::Zero();    ///< DᵀD.
+  Mat3 PG = Mat3::Zero();   ///< P G, 1/kg.
+  Vec3 Pt = Vec3::Zero();   ///< P Dᵀ (the points' target normal speeds), N·s.
+  std::array<Vec3, 3> ca, cb;          ///< Columns of C: (r0 × n, t1 × n, t2 × n) of a and b, m.
+  std::array<Vec3, 3> inv_ca, inv_cb;  ///< I⁻¹ times those columns, 1/(kg·m).
   std::array<PointRows, kMaxContactPoints> points;  ///< Rows of each point.
 };
 
