@@ -19,17 +19,15 @@ inline constexpr std::uint32_t kStaticBody = 0xFFFFFFFFu;
 /// Most points of one contact: 4 for box–box, up to 8 box vertices on the floor.
 inline constexpr int kMaxContactPoints = 8;
 
-/// One point of a contact, with the impulses it accumulated (kept for warm starting).
+/// One point of a contact, with the normal impulse it accumulated (kept for warm starting).
 struct ContactPoint {
   Vec3 position = Vec3::Zero();  ///< World, m.
   double separation = 0.0;       ///< Gap along the normal at the start of the step, m.
   std::uint32_t id = 0;          ///< Feature id (persistent between steps).
   double normal_impulse = 0.0;   ///< Accumulated normal impulse, N·s (≥ 0).
-  std::array<double, 2> tangent_impulse{};  ///< Accumulated friction impulse, N·s.
   // Per-step solver data.
   Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  ///< Offsets from the centres of mass, m.
   double normal_mass = 0.0;                   ///< 1 / (n·K n), kg.
-  std::array<double, 2> tangent_mass{};       ///< 1 / (t·K t), kg.
   double pseudo_impulse = 0.0;                ///< Split-impulse position correction, N·s.
 };
 
@@ -41,6 +39,9 @@ struct Contact {
   double friction = 0.0;          ///< Coulomb μ of the pair.
   double restitution = 0.0;       ///< e of the pair (applied to impacts only).
   int count = 0;                  ///< Points in use.
+  /// Accumulated patch friction (kept for warm starting): along t1 and t2 at the points'
+  /// centroid, N·s, and the twist about the normal, N·m·s.
+  std::array<double, 3> friction_impulse{};
   std::array<ContactPoint, kMaxContactPoints> points{};
 };
 
@@ -62,7 +63,8 @@ inline constexpr double kSpeculativeDistance = 0.02;
 int floor_contact(const BodyState& s, const BodyConstants& c, std::uint32_t body,
                   double floor_y, double margin, Contact& out);
 
-/// Copies the accumulated impulses of points with the same feature id from `previous`.
+/// Copies the accumulated impulses of points with the same feature id, and the patch friction,
+/// from `previous`.
 void warm_start_from(Contact& contact, const Contact& previous);
 
 /// Velocities of a body during the solve (I⁻¹ fixed at the start of the step).
@@ -75,13 +77,21 @@ struct SolverBody {
   double inv_mass = 0.0;            ///< 1/kg.
 };
 
-/// One contact point's rows along the normal and the two tangents (k = 0, 1, 2), computed
-/// once a step so that the iterations are dot products and axpys (Box2D's contact solver).
+/// One contact point's row along the normal, computed once a step so that the iterations are
+/// dot products and axpys (Box2D's contact solver).
 struct PointRows {
-  std::array<Vec3, 3> ang_a;  ///< ra × d_k, m (zero for the floor).
-  std::array<Vec3, 3> ang_b;  ///< rb × d_k, m.
-  std::array<Vec3, 3> inv_a;  ///< I_a⁻¹ (ra × d_k), 1/(kg·m).
-  std::array<Vec3, 3> inv_b;  ///< I_b⁻¹ (rb × d_k), 1/(kg·m).
+  Vec3 ang_a;  ///< ra × n, m (zero for the floor).
+  Vec3 ang_b;  ///< rb × n, m.
+  Vec3 inv_a;  ///< I_a⁻¹ (ra × n), 1/(kg·m).
+  Vec3 inv_b;  ///< I_b⁻¹ (rb × n), 1/(kg·m).
+};
+
+/// A contact's three friction rows: t1 and t2 at the points' centroid, the twist about n.
+struct FrictionRows {
+  std::array<Vec3, 3> ang_a, ang_b;  ///< r0 × t1, r0 × t2, n of each body, m (twist: 1).
+  std::array<Vec3, 3> inv_a, inv_b;  ///< I⁻¹ times those, 1/(kg·m).
+  std::array<double, 3> mass{};      ///< 1 / (d·K d) of each row, kg (twist: kg·m²).
+  double radius = 0.0;               ///< Mean distance of the points from their centroid, m.
 };
 
 /// A contact's solver data: its directions, its points' rows and its normal block in the
@@ -97,7 +107,8 @@ struct ContactRows {
   Vec3 Pt = Vec3::Zero();   ///< P Dᵀ (the points' target normal speeds), N·s.
   std::array<Vec3, 3> ca, cb;          ///< Columns of C: (r0 × n, t1 × n, t2 × n) of a and b, m.
   std::array<Vec3, 3> inv_ca, inv_cb;  ///< I⁻¹ times those columns, 1/(kg·m).
-  std::array<PointRows, kMaxContactPoints> points;  ///< Rows of each point.
+  FrictionRows friction;                            ///< The patch's friction rows.
+  std::array<PointRows, kMaxContactPoints> points;  ///< Normal row of each point.
 };
 
 /// The solver's buffers, reused between steps.
