@@ -227,20 +227,22 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
     if (s > margin) return m;
     if (s > best_b) best_b = s, axis_b = j;
   }
+  // The edge axes a_i × b_j from C alone (Ericson §4.4.1): in A's frame the axis is
+  // e_i × C(:, j), whose components i1, i2 are −C(i2, j) and C(i1, j), so its length, the
+  // projection of d and both boxes' radii along it are a few products of C's entries.
   double best_edge = -INFINITY;
   int edge_i = -1, edge_j = -1;
-  Vec3 edge_axis = Vec3::Zero();
   for (int i = 0; i < 3; ++i) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
     for (int j = 0; j < 3; ++j) {
-      Vec3 axis = a.R.col(i).cross(b.R.col(j));
-      const double len = axis.norm();
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      const double len = std::sqrt(C(i1, j) * C(i1, j) + C(i2, j) * C(i2, j));
       if (len < 1e-6) continue;  // parallel edges: covered by the face axes
-      axis /= len;
-      const double ra = (a.R.transpose() * axis).cwiseAbs().dot(ha);
-      const double rb = (b.R.transpose() * axis).cwiseAbs().dot(hb);
-      const double s = std::abs(d.dot(axis)) - (ra + rb);
+      const double ra = ha(i1) * absC(i2, j) + ha(i2) * absC(i1, j);
+      const double rb = hb(j1) * absC(i, j2) + hb(j2) * absC(i, j1);
+      const double s = (std::abs(da(i2) * C(i1, j) - da(i1) * C(i2, j)) - (ra + rb)) / len;
       if (s > margin) return m;
-      if (s > best_edge) best_edge = s, edge_i = i, edge_j = j, edge_axis = axis;
+      if (s > best_edge) best_edge = s, edge_i = i, edge_j = j;
     }
   }
 
@@ -248,7 +250,9 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
   const double edge_tolerance =
       kEdgeTolerance + kEdgeRelativeTolerance * std::min(ha.minCoeff(), hb.minCoeff());
   if (edge_i >= 0 && best_edge > best_face + edge_tolerance &&
-      edge_contact(a, ca, b, cb, edge_i, edge_j, edge_axis, m) && m.points[0].separation < margin)
+      edge_contact(a, ca, b, cb, edge_i, edge_j, a.R.col(edge_i).cross(b.R.col(edge_j)).normalized(),
+                   m) &&
+      m.points[0].separation < margin)
     return m;
   m = BoxManifold{};
 

@@ -12,44 +12,55 @@ namespace {
 // near each other keep the lone path with the scene's exact integrator.
 constexpr double kTouchDistance = 1e-3;
 
+/// The velocities of a body, m/s and rad/s.
+struct Motion {
+  Vec3 v;
+  Vec3 w;
+};
+
+Motion motion_of(const Body& b) { return {b.s.P * b.c.inv_mass, angular_velocity(b.s, b.c)}; }
+
 /// True when some point of the manifold touches or will touch within dt.
-bool touches(const BoxManifold& m, const Body& a, const Body& b, double dt) {
-  const Vec3 va = a.s.P * a.c.inv_mass, vb = b.s.P * b.c.inv_mass;
-  const Vec3 wa = angular_velocity(a.s, a.c), wb = angular_velocity(b.s, b.c);
+bool touches(const BoxManifold& m, const Body& a, const Motion& ma, const Body& b,
+             const Motion& mb, double dt) {
   for (int i = 0; i < m.count; ++i) {
     const Vec3& p = m.points[i].position;
-    const double vn = (vb + wb.cross(p - b.s.x) - va - wa.cross(p - a.s.x)).dot(m.normal);
+    const double vn =
+        (mb.v + mb.w.cross(p - b.s.x) - ma.v - ma.w.cross(p - a.s.x)).dot(m.normal);
     if (m.points[i].separation + std::min(vn, 0.0) * dt <= kTouchDistance) return true;
   }
   return false;
 }
 
-Contact contact_of(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const Body& ba,
-                   const Body& bb) {
-  Contact c;
+/// Writes the contact of manifold m between bodies a and b into c (its points past m.count
+/// are left as they were: nothing reads them).
+void write_contact(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const Body& ba,
+                   const Body& bb, Contact& c) {
   c.a = a;
   c.b = b;
   c.normal = m.normal;
   c.friction = std::sqrt(ba.c.friction * bb.c.friction);
   c.restitution = std::max(ba.c.restitution, bb.c.restitution);
   c.count = m.count;
+  c.friction_impulse = {};
   for (int i = 0; i < m.count; ++i) {
-    c.points[i].position = m.points[i].position;
-    c.points[i].separation = m.points[i].separation;
-    c.points[i].id = m.points[i].id;
+    ContactPoint& p = c.points[i];
+    p = ContactPoint{};
+    p.position = m.points[i].position;
+    p.separation = m.points[i].separation;
+    p.id = m.points[i].id;
   }
-  return c;
 }
 
 /// The manifold of pair p, or none (count 0) when its boxes will not touch within the step.
 BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p) {
   const Body& a = ctx.bodies[p.first];
   const Body& b = ctx.bodies[p.second];
-  const double closing = ctx.dt * ((a.s.P * a.c.inv_mass - b.s.P * b.c.inv_mass).norm() +
-                                   angular_velocity(a.s, a.c).norm() * a.c.bounding_radius +
-                                   angular_velocity(b.s, b.c).norm() * b.c.bounding_radius);
+  const Motion ma = motion_of(a), mb = motion_of(b);
+  const double closing = ctx.dt * ((ma.v - mb.v).norm() + ma.w.norm() * a.c.bounding_radius +
+                                   mb.w.norm() * b.c.bounding_radius);
   BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
-  if (m.count > 0 && !touches(m, a, b, ctx.dt)) m.count = 0;
+  if (m.count > 0 && !touches(m, a, ma, b, mb, ctx.dt)) m.count = 0;
   return m;
 }
 
@@ -80,8 +91,8 @@ void collide_pairs(StepContext& ctx) {
     for (std::size_t k = begin; k < end; ++k) {
       if (s.slot[k] < 0) continue;
       const BodyPair& p = s.pairs[k];
-      s.box_contacts[s.slot[k]] =
-          contact_of(s.manifolds[k], p.first, p.second, ctx.bodies[p.first], ctx.bodies[p.second]);
+      write_contact(s.manifolds[k], p.first, p.second, ctx.bodies[p.first],
+                    ctx.bodies[p.second], s.box_contacts[s.slot[k]]);
       s.links[s.slot[k]] = p;
     }
   });
