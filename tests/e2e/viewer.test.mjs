@@ -147,7 +147,21 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
       const scene = await getJson(base, 'scene');
       const mass = scene.bodies[0].mass ?? 1;
       const before = (await getJson(base, 'state')).bodies[0];
+      // The scene's caption stays 12 s after the page loads, bottom left: a user clicks it
+      // away first when it covers the box (it did in CI, where this step came ~10 s in).
+      const covering = () => page.evaluate(([x, y]) => {
+        const el = document.elementFromPoint(x, y);
+        return el?.tagName === 'CANVAS' ? null : `${el?.tagName}#${el?.id}`;
+      }, [paused.x, paused.y]);
+      if ((await covering()) === 'DIV#description') {
+        t.diagnostic('the scene caption covered the box: clicked away first');
+        await page.click('#description');
+      }
+      assert.equal(await covering(), null, 'nothing covers the box where it is clicked');
+      const kickBefore = await page.evaluate(() => JSON.stringify(window.tumble.lastKick));
       await page.mouse.click(paused.x, paused.y);
+      await until('the page to send a kick for the click', () => page.evaluate(
+        (old) => JSON.stringify(window.tumble.lastKick) !== old, kickBefore), 5000);
       const after = await until('the impulse to change the body velocity', async () => {
         const body = (await getJson(base, 'state')).bodies[0];
         const dv = Math.hypot(...body.velocity.map((v, k) => v - before.velocity[k]));

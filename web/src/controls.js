@@ -44,6 +44,7 @@ export class Controls {
     this.aim = new KickAim(viewer);
     this.lastKick = null; // {body, impulse, point} of the newest kick sent
     this.onInspect = () => {}; // set by main.js: (body index) → show it in the inspector
+    this.inspected = () => -1; // …the body the inspector shows (−1: none)
     this.inspectOnClick = () => false; // …and whether a click inspects rather than kicks
     this.extraShortcuts = {}; // more key → action pairs (main.js)
     // What Resume (and space) sends: main.js makes it a playback while the timeline shows the
@@ -176,6 +177,10 @@ export class Controls {
    * along the view ray (or, with the inspector on, inspects); dragged, it aims (aim.js); held
    * still for kLongPressMs, it inspects. A press elsewhere orbits, pans and zooms as before; a
    * second finger hands the gesture back to the orbit controls.
+   *
+   * Click or long press is decided by the events' own timestamps: on a busy page (a slow frame,
+   * a phone) the long-press timer can run before a release that came in time, and that release
+   * is still a click: the inspector goes back to what it showed and the box is kicked.
    */
   #bindPointer(canvas) {
     let press = null; // {id, x, y, hit, aiming, timer, done}
@@ -195,7 +200,10 @@ export class Controls {
       if (!hit) return;
       this.viewer.controls.enabled = false;
       canvas.setPointerCapture?.(e.pointerId);
-      press = { id: e.pointerId, x: e.clientX, y: e.clientY, hit, aiming: false, done: false };
+      press = {
+        id: e.pointerId, x: e.clientX, y: e.clientY, t0: e.timeStamp, hit, aiming: false, done: false,
+        inspected: this.inspected(),
+      };
       press.timer = setTimeout(() => {
         if (!press || press.aiming) return;
         press.done = true;
@@ -213,11 +221,13 @@ export class Controls {
     canvas.addEventListener('pointerup', (e) => {
       if (!press || e.pointerId !== press.id) return;
       const { hit, aiming, done } = press;
+      const quick = e.timeStamp - press.t0 < kLongPressMs;
       if (aiming) {
         this.aim.update(e.clientX, e.clientY);
         const kick = this.aim.finish(this.params.impulse);
         if (kick) this.#sendKick(kick.body, kick.impulse, kick.point);
-      } else if (!done) {
+      } else if (!done || quick) {
+        if (done) this.onInspect(press.inspected); // the timer ran late: undo its inspection
         if (this.inspectOnClick()) this.onInspect(hit.body);
         else this.kick(press.x, press.y);
       }

@@ -35,6 +35,7 @@ const viewMenu = new ViewMenu(controls.viewFolder, {
   subscribe: (what, on) => worker.postMessage({ type: 'subscribe', what, on }),
 });
 controls.onInspect = (i) => inspector.show(i);
+controls.inspected = () => inspector.body;
 controls.resume = () => (timeline.inPast ? api.play(timeline.speed) : api.resume());
 controls.inspectOnClick = () => viewMenu.inspectOnClick;
 inspector.onFollow = (i) => viewer.follow(i);
