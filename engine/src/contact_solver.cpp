@@ -203,6 +203,10 @@ class Solver {
   /// The patch friction of one contact on velocities held in locals (see solve_velocity).
   static void solve_friction(Contact& c, const ContactRows& rows, Motion& a, Motion& b,
                              double ma, double mb);
+  /// The block step of the normal impulses of a contact of two or more points; false (and
+  /// nothing changed) when it would pull at a point.
+  static bool solve_normal_block(Contact& c, const ContactRows& rows, Motion& a, Motion& b,
+                                 double ma, double mb);
   /// Writes the end-of-step momenta P = m v, L = I w (I at the step start) of solver bodies
   /// [begin, end).
   void finish(std::size_t begin, std::size_t end);
@@ -338,11 +342,14 @@ void Solver::solve_friction(Contact& c, const ContactRows& rows, Motion& a, Moti
   const double j0 = n0 - old0, j1 = n1 - old1;
   total[0] = n0;
   total[1] = n1;
-  const double old2 = total[2];
-  const double twist_limit = limit * f.radius;
-  total[2] = std::clamp(old2 - f.mass[2] * (b.w.dot(f.ang_b[2]) - a.w.dot(f.ang_a[2])),
-                        -twist_limit, twist_limit);
-  const double j2 = total[2] - old2;
+  double j2 = 0.0;  // a single point resists no twist
+  if (f.radius > 0.0) {
+    const double old2 = total[2];
+    const double twist_limit = limit * f.radius;
+    total[2] = std::clamp(old2 - f.mass[2] * (b.w.dot(f.ang_b[2]) - a.w.dot(f.ang_a[2])),
+                          -twist_limit, twist_limit);
+    j2 = total[2] - old2;
+  }
   const Vec3 j = j0 * rows.dir[1] + j1 * rows.dir[2];
   if (ma > 0.0) {
     a.v -= ma * j;
@@ -352,20 +359,19 @@ void Solver::solve_friction(Contact& c, const ContactRows& rows, Motion& a, Moti
   b.w += j0 * f.inv_b[0] + j1 * f.inv_b[1] + j2 * f.inv_b[2];
 }
 
-void Solver::solve_velocity_rows(Contact& c, const ContactRows& rows, Motion& a, Motion& b,
-                                 double ma, double mb, double dt) {
-  solve_friction(c, rows, a, b, ma, mb);
-  // Block solve of the contact's normal impulses: all points at once through the
-  // pseudo-inverse of K (Box2D's two-point block solver, generalised with the pseudo-inverse
-  // for a face patch, whose four coplanar points have only three independent normal modes).
-  // Point-by-point Gauss–Seidel leaves such a patch rocking; the block step removes it. When
-  // the block answer would pull at a point, the points fall back to one clamped sweep.
-  //
-  // The block works in the patch's three coordinates (ContactRows): the points' normal speeds
-  // are vn = D y, the step is z = P Dᵀ(target − vn) = P Dᵀtarget − P G y, each point's impulse
-  // changes by dᵢ·z, and their sum moves the bodies by the wrench u = G z along the columns C.
-  // Per point only one dot product remains, so a four-point face costs about half the
-  // point-by-point form it replaced and an eight-vertex floor contact a third.
+// Block solve of the contact's normal impulses: all points at once through the
+// pseudo-inverse of K (Box2D's two-point block solver, generalised with the pseudo-inverse
+// for a face patch, whose four coplanar points have only three independent normal modes).
+// Point-by-point Gauss–Seidel leaves such a patch rocking; the block step removes it. When
+// the block answer would pull at a point, the points fall back to one clamped sweep.
+//
+// The block works in the patch's three coordinates (ContactRows): the points' normal speeds
+// are vn = D y, the step is z = P Dᵀ(target − vn) = P Dᵀtarget − P G y, each point's impulse
+// changes by dᵢ·z, and their sum moves the bodies by the wrench u = G z along the columns C.
+// Per point only one dot product remains, so a four-point face costs about half the
+// point-by-point form it replaced and an eight-vertex floor contact a third.
+bool Solver::solve_normal_block(Contact& c, const ContactRows& rows, Motion& a, Motion& b,
+                                double ma, double mb) {
   const int n = c.count;
   const Vec3 wr = b.w - a.w;
   const Vec3 y(rows.dir[0].dot(b.v - a.v) + b.w.dot(rows.cb[0]) - a.w.dot(rows.ca[0]),
@@ -386,8 +392,17 @@ void Solver::solve_velocity_rows(Contact& c, const ContactRows& rows, Motion& a,
     }
     b.v += (mb * u(0)) * rows.dir[0];
     b.w += u(0) * rows.inv_cb[0] + u(1) * rows.inv_cb[1] + u(2) * rows.inv_cb[2];
-    return;
+    return true;
   }
+  return false;
+}
+
+void Solver::solve_velocity_rows(Contact& c, const ContactRows& rows, Motion& a, Motion& b,
+                                 double ma, double mb, double dt) {
+  solve_friction(c, rows, a, b, ma, mb);
+  const int n = c.count;
+  // One point: the clamped sweep below is the block step.
+  if (n > 1 && solve_normal_block(c, rows, a, b, ma, mb)) return;
   for (int i = 0; i < n; ++i) {
     ContactPoint& p = c.points[i];
     const double vn = normal_speed(a, b, rows.dir[0], rows.points[i]);
