@@ -111,6 +111,7 @@ bool rescan(StepContext& ctx) {
   k.active.resize(n);
   k.candidate.resize(n);
   k.unpaired.resize(n, 0);
+  k.escaped.resize(n, 0);
   k.awake.clear();
   for (std::uint32_t i = 0; i < n; ++i) {
     const bool was_active = i < known && k.active[i];
@@ -132,16 +133,23 @@ bool rescan(StepContext& ctx) {
   return pairs_hold;
 }
 
-/// Pairs of the woken bodies with every candidate whose fat box meets theirs, merged into
-/// the cached pairs (sorted, each once): the pairs a new sweep would find. Worth it while
-/// woken × bodies overlap tests cost less than a sweep, whose cost grows faster than the
-/// bodies (~6,000 instructions a box in a 3-D pile). Returns false past that bound or past the
-/// pair budget: the caller then sweeps.
+/// Pairs of the woken bodies (and of those that left their fat box) with every candidate
+/// whose fat box meets theirs, merged into the cached pairs (sorted, each once): every pair a
+/// new sweep would find, and perhaps a few it would no longer (pairs of a body's old fat box:
+/// the tight boxes filter them each step, so the pairs passed on are the same). Worth it while
+/// woken × bodies overlap tests (~10 instructions each) cost less than a sweep, whose cost
+/// grows faster than the bodies: 6,000–16,000 instructions per awake box in a 3-D pile, whose
+/// boxes in contact leave their fat boxes by the hundred every few steps. Returns false past
+/// that bound (256 tests per awake body, or 65,536), past the pair budget or once the stale
+/// pairs could have doubled the list: the caller then sweeps.
 bool add_woken_pairs(StepContext& ctx) {
   constexpr std::size_t kMaxTests = 1u << 16;
+  constexpr std::size_t kTestsPerAwakeBody = 256;
   BroadPhaseCache& k = ctx.broad;
   const std::size_t n = ctx.bodies.size();
-  if (k.woken.size() * n > kMaxTests) return false;
+  if (k.woken.size() * n > std::max(kMaxTests, kTestsPerAwakeBody * k.awake.size()))
+    return false;
+  if (k.fat_pairs.size() > 2 * k.swept_pairs + 64) return false;
   for (std::uint32_t w : k.woken)
     k.fat[w] = fat_box(k.boxes[w], ctx.bodies[w], ctx.world.gravity, ctx.dt);
   const std::size_t cached = k.fat_pairs.size();
@@ -184,16 +192,25 @@ void broad_phase(StepContext& ctx) {
   if (full && !rescan(ctx)) k.fat_valid = false;
   // Each awake body's box on its own, shared among the pool's threads; the flags are ORed.
   std::atomic<bool> rebuild = !k.fat_valid;
+  std::atomic<bool> escaped = false;
   ctx.pool.for_each(k.awake.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    bool changed = false;
+    bool changed = false, left = false;
     for (std::size_t a = begin; a < end; ++a) {
       const std::uint32_t i = k.awake[a];
-      const bool candidacy = update_box(ctx, i);
-      changed = candidacy || changed || (!k.unpaired[i] && !contains(k.fat[i], k.boxes[i]));
+      changed = update_box(ctx, i) || changed;
+      k.escaped[i] = !k.unpaired[i] && !contains(k.fat[i], k.boxes[i]);
+      left = left || k.escaped[i];
     }
     if (changed) rebuild.store(true, std::memory_order_relaxed);
+    if (left) escaped.store(true, std::memory_order_relaxed);
   });
   if (n < 2 || k.awake.empty()) return;
+  // A body out of its fat box is paired again as a woken one is (add_woken_pairs), in body
+  // order; many of them (a pile's first seconds: every box in contact keeps a tight fat box)
+  // still cost a sweep.
+  if (!rebuild.load() && escaped.load())
+    for (std::uint32_t i : k.awake)
+      if (k.escaped[i]) k.unpaired[i] = 1, k.woken.push_back(i);
   if (!rebuild.load() && !k.woken.empty() && !add_woken_pairs(ctx)) rebuild.store(true);
   clear_woken(k);
   if (rebuild.load()) {
@@ -205,6 +222,7 @@ void broad_phase(StepContext& ctx) {
     });
     k.fat_complete = find_pairs(k.fat, k.active, k.candidate, k.awake, k.epoch, k.sweep,
                                 k.fat_pairs, pair_budget(n), ctx.pool);
+    k.swept_pairs = k.fat_pairs.size();
     k.fat_valid = true;
   }
   for (const BodyPair& p : k.fat_pairs)

@@ -58,8 +58,11 @@ struct BroadPhaseCache {
   std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
   bool fat_valid = false;                ///< fat_pairs holds every pair that can touch,
                                          ///< but those of the bodies in `woken`.
-  std::vector<std::uint32_t> woken;      ///< Bodies woken since fat_pairs was found.
+  std::vector<std::uint32_t> woken;      ///< Bodies woken, or out of their fat box, since
+                                         ///< fat_pairs was found.
   std::vector<std::uint8_t> unpaired;    ///< Body is in `woken` (its fat box is stale).
+  std::vector<std::uint8_t> escaped;     ///< Awake body left its fat box this step.
+  std::size_t swept_pairs = 0;           ///< fat_pairs' size after the last sweep.
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
 };
 
