@@ -137,18 +137,14 @@ bool rescan(StepContext& ctx) {
 /// whose fat box meets theirs, merged into the cached pairs (sorted, each once): every pair a
 /// new sweep would find, and perhaps a few it would no longer (pairs of a body's old fat box:
 /// the tight boxes filter them each step, so the pairs passed on are the same). Worth it while
-/// woken × bodies overlap tests (~10 instructions each) cost less than a sweep, whose cost
-/// grows faster than the bodies: 6,000–16,000 instructions per awake box in a 3-D pile, whose
-/// boxes in contact leave their fat boxes by the hundred every few steps. Returns false past
-/// that bound (256 tests per awake body, or 65,536), past the pair budget or once the stale
+/// woken × bodies overlap tests cost less than a sweep: at most 65,536 of them, or as many as
+/// the last sweep made. Returns false past that bound, past the pair budget or once the stale
 /// pairs could have doubled the list: the caller then sweeps.
 bool add_woken_pairs(StepContext& ctx) {
   constexpr std::size_t kMaxTests = 1u << 16;
-  constexpr std::size_t kTestsPerAwakeBody = 256;
   BroadPhaseCache& k = ctx.broad;
   const std::size_t n = ctx.bodies.size();
-  if (k.woken.size() * n > std::max(kMaxTests, kTestsPerAwakeBody * k.awake.size()))
-    return false;
+  if (k.woken.size() * n > std::max(kMaxTests, k.sweep.tests)) return false;
   if (k.fat_pairs.size() > 2 * k.swept_pairs + 64) return false;
   for (std::uint32_t w : k.woken)
     k.fat[w] = fat_box(k.boxes[w], ctx.bodies[w], ctx.world.gravity, ctx.dt);
@@ -166,6 +162,19 @@ bool add_woken_pairs(StepContext& ctx) {
   std::merge(k.fat_pairs.begin(), mid, mid, k.fat_pairs.end(), merged.begin());
   merged.erase(std::unique(merged.begin(), merged.end()), merged.end());
   k.fat_pairs.swap(merged);
+  return true;
+}
+
+/// Lists the `escaped` bodies that left their fat box with the woken ones, to be paired the
+/// same way (add_woken_pairs), when a quarter of the last sweep's overlap tests pays for it; false
+/// (nothing listed): sweep. A sweep renews every fat box at once: over separated boxes, whose
+/// sweeps cost a few tests per box, pairing each body as it leaves cost more than the sweep
+/// once every kFatSteps steps. A 3-D pile's sweep makes over a thousand tests per box, and
+/// its boxes in contact (their fat boxes are tight) leave them by the hundred every few steps.
+bool pair_escaped(BroadPhaseCache& k, std::size_t escaped, std::size_t n) {
+  if ((k.woken.size() + escaped) * n > k.sweep.tests / 4) return false;
+  for (std::uint32_t i : k.awake)
+    if (k.escaped[i]) k.unpaired[i] = 1, k.woken.push_back(i);
   return true;
 }
 
@@ -192,25 +201,22 @@ void broad_phase(StepContext& ctx) {
   if (full && !rescan(ctx)) k.fat_valid = false;
   // Each awake body's box on its own, shared among the pool's threads; the flags are ORed.
   std::atomic<bool> rebuild = !k.fat_valid;
-  std::atomic<bool> escaped = false;
+  std::atomic<std::size_t> escaped = 0;
   ctx.pool.for_each(k.awake.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    bool changed = false, left = false;
+    bool changed = false;
+    std::size_t left = 0;
     for (std::size_t a = begin; a < end; ++a) {
       const std::uint32_t i = k.awake[a];
       changed = update_box(ctx, i) || changed;
       k.escaped[i] = !k.unpaired[i] && !contains(k.fat[i], k.boxes[i]);
-      left = left || k.escaped[i];
+      left += k.escaped[i];
     }
     if (changed) rebuild.store(true, std::memory_order_relaxed);
-    if (left) escaped.store(true, std::memory_order_relaxed);
+    if (left) escaped.fetch_add(left, std::memory_order_relaxed);
   });
   if (n < 2 || k.awake.empty()) return;
-  // A body out of its fat box is paired again as a woken one is (add_woken_pairs), in body
-  // order; many of them (a pile's first seconds: every box in contact keeps a tight fat box)
-  // still cost a sweep.
-  if (!rebuild.load() && escaped.load())
-    for (std::uint32_t i : k.awake)
-      if (k.escaped[i]) k.unpaired[i] = 1, k.woken.push_back(i);
+  if (!rebuild.load() && escaped.load() > 0 && !pair_escaped(k, escaped.load(), n))
+    rebuild.store(true);
   if (!rebuild.load() && !k.woken.empty() && !add_woken_pairs(ctx)) rebuild.store(true);
   clear_woken(k);
   if (rebuild.load()) {

@@ -45,6 +45,8 @@ struct SweepScratch {
   std::vector<BodyPair> sorted;           ///< Scratch of the pair sort: the sorted pairs.
   double sleeping_width = 0.0;            ///< Widest sleeping interval, m.
   std::vector<std::vector<BodyPair>> range_pairs;  ///< Scratch: pairs of each sweep range.
+  std::vector<std::size_t> range_tests;            ///< Scratch: overlap tests of each range.
+  std::size_t tests = 0;  ///< Overlap tests the last sweep made (its cost, for the caller).
 };
 
 /// Every pair whose boxes overlap and of which at least one body is `active` (sleeping pairs
