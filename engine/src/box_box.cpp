@@ -25,24 +25,32 @@ constexpr double kClipTolerance = 1e-4;
 /// (4 bits each) identify it from step to step.
 struct ClipVertex {
   Vec3 p;
-  unsigned edges = 0;
-  unsigned planes = 0;
+  unsigned edges;
+  unsigned planes;
 };
 
 struct Polygon {
   int count = 0;
-  std::array<ClipVertex, kMaxClipped> v;
+  std::array<ClipVertex, kMaxClipped> v;  // [0, count) in use
 };
 
-/// Sutherland–Hodgman: keeps the part of `in` where distance(q) ≤ 0 (one side plane of the
-/// reference face).
+/// Sutherland–Hodgman: writes to `out` the part of `in` where distance(q) ≤ 0 (one side plane
+/// of the reference face) and returns true; returns false, writing nothing, when all of `in`
+/// is inside (the part is `in` itself). Each vertex's distance is found once.
 template <typename Distance>
-Polygon clip(const Polygon& in, int plane, Distance distance) {
-  Polygon out;
+bool clip(const Polygon& in, int plane, Distance distance, Polygon& out) {
+  std::array<double, kMaxClipped> d;
+  bool inside = true;
   for (int i = 0; i < in.count; ++i) {
-    const ClipVertex& a = in.v[(i + in.count - 1) % in.count];
+    d[i] = distance(in.v[i].p) - kClipTolerance;
+    inside = inside && d[i] <= 0.0;
+  }
+  if (inside) return false;
+  out.count = 0;
+  for (int i = 0, prev = in.count - 1; i < in.count; prev = i++) {
+    const ClipVertex& a = in.v[prev];
     const ClipVertex& b = in.v[i];
-    const double da = distance(a.p) - kClipTolerance, db = distance(b.p) - kClipTolerance;
+    const double da = d[prev], db = d[i];
     if ((da <= 0.0) != (db <= 0.0)) {
       ClipVertex x;
       x.p = a.p + (da / (da - db)) * (b.p - a.p);
@@ -52,7 +60,7 @@ Polygon clip(const Polygon& in, int plane, Distance distance) {
     }
     if (db <= 0.0 && out.count < kMaxClipped) out.v[out.count++] = b;
   }
-  return out;
+  return true;
 }
 
 struct Box {
@@ -77,27 +85,33 @@ int clip_faces(const Box& ref, int ref_axis, const Vec3& n_ref, const Box& inc, 
   const Vec3 c = inc.s.x + side * inc.c.half_extents(k) * inc.s.R.col(k);
   const Vec3 e1 = inc.c.half_extents(k1) * inc.s.R.col(k1);
   const Vec3 e2 = inc.c.half_extents(k2) * inc.s.R.col(k2);
-  Polygon poly;
-  poly.count = 4;
+  std::array<Polygon, 2> buffers;  // the polygon and the next clip's output, in turn
+  Polygon* poly = &buffers[0];
+  Polygon* next = &buffers[1];
+  poly->count = 4;
   const Vec3 corners[4] = {c + e1 + e2, c - e1 + e2, c - e1 - e2, c + e1 - e2};
   for (int i = 0; i < 4; ++i) {
     // Vertex i lies on incident edges i (to i+1) and i−1.
-    poly.v[i] = {corners[i], (1u << i) | (1u << ((i + 3) % 4)), 0u};
+    poly->v[i] = {corners[i], (1u << i) | (1u << ((i + 3) % 4)), 0u};
   }
-  poly = clip(poly, 0, [&](const Vec3& q) { return (q - ref_center).dot(u) - hu; });
-  poly = clip(poly, 1, [&](const Vec3& q) { return -(q - ref_center).dot(u) - hu; });
-  poly = clip(poly, 2, [&](const Vec3& q) { return (q - ref_center).dot(v) - hv; });
-  poly = clip(poly, 3, [&](const Vec3& q) { return -(q - ref_center).dot(v) - hv; });
+  auto clip_by = [&](int plane, auto distance) {
+    if (clip(*poly, plane, distance, *next)) std::swap(poly, next);
+  };
+  clip_by(0, [&](const Vec3& q) { return (q - ref_center).dot(u) - hu; });
+  clip_by(1, [&](const Vec3& q) { return -(q - ref_center).dot(u) - hu; });
+  clip_by(2, [&](const Vec3& q) { return (q - ref_center).dot(v) - hv; });
+  clip_by(3, [&](const Vec3& q) { return -(q - ref_center).dot(v) - hv; });
 
   const std::uint32_t inc_face = static_cast<std::uint32_t>(2 * k + (side > 0.0 ? 1 : 0));
   int n = 0;
-  for (int i = 0; i < poly.count; ++i) {
-    const double depth = (poly.v[i].p - ref_center).dot(n_ref);
+  for (int i = 0; i < poly->count; ++i) {
+    const ClipVertex& q = poly->v[i];
+    const double depth = (q.p - ref_center).dot(n_ref);
     if (depth >= margin) continue;
     ManifoldPoint& p = out[n++];
-    p.position = poly.v[i].p - (0.5 * depth) * n_ref;
+    p.position = q.p - (0.5 * depth) * n_ref;
     p.separation = depth;
-    p.id = id_base | (inc_face << 8) | (poly.v[i].planes << 4) | poly.v[i].edges;
+    p.id = id_base | (inc_face << 8) | (q.planes << 4) | q.edges;
   }
   return n;
 }
