@@ -81,11 +81,14 @@ class Solver {
     tangents(c.normal, block.dir[1], block.dir[2]);
     block.dir[0] = c.normal;
     const Vec3& normal = c.normal;
+    Vec3 ra0 = Vec3::Zero(), rb0 = Vec3::Zero();  // the points' centroid from each centre
     for (int i = 0; i < c.count; ++i) {
       ContactPoint& p = c.points[i];
       p.ra = c.a == kStaticBody ? p.position : Vec3(p.position - bodies_[c.a].s.x);
       p.rb = p.position - bodies_[c.b].s.x;
       p.pseudo_impulse = 0.0;
+      ra0 += p.ra;
+      rb0 += p.rb;
       PointRows& r = block.points[i];
       r.ang_a = a ? Vec3(p.ra.cross(normal)) : Vec3::Zero();
       r.inv_a = a ? Vec3(a->inv_inertia * r.ang_a) : Vec3::Zero();
@@ -95,18 +98,25 @@ class Solver {
                        r.ang_b.dot(r.inv_b);  // n·K n, 1/kg
       p.normal_mass = 1.0 / k;
     }
-    prepare_block(c, block, a, b, dt);
-    prepare_friction(c, block, a, b);
-  }
-
-  /// The patch friction rows of `rows` (FrictionRows): the tangents at the points' centroid
-  /// and the twist about the normal.
-  static void prepare_friction(const Contact& c, ContactRows& rows, const SolverBody* a,
-                               const SolverBody* b) {
-    Vec3 ra0 = Vec3::Zero(), rb0 = Vec3::Zero();
-    for (int i = 0; i < c.count; ++i) ra0 += c.points[i].ra, rb0 += c.points[i].rb;
     ra0 /= c.count;
     rb0 /= c.count;
+    prepare_block(c, block, a, b, ra0, rb0, dt);
+    // Friction acts at the patch's centre of pressure (see solve_friction).
+    double load = 0.0;
+    Vec3 ra_load = Vec3::Zero(), rb_load = Vec3::Zero();
+    for (int i = 0; i < c.count; ++i) {
+      load += c.points[i].normal_impulse;
+      ra_load += c.points[i].normal_impulse * c.points[i].ra;
+      rb_load += c.points[i].normal_impulse * c.points[i].rb;
+    }
+    if (load > 0.0) prepare_friction(c, block, a, b, ra_load / load, rb_load / load);
+    else prepare_friction(c, block, a, b, ra0, rb0);
+  }
+
+  /// The patch friction rows of `rows` (FrictionRows): the tangents at the point ra0, rb0 (m,
+  /// from the centres) and the twist about the normal.
+  static void prepare_friction(const Contact& c, ContactRows& rows, const SolverBody* a,
+                               const SolverBody* b, const Vec3& ra0, const Vec3& rb0) {
     FrictionRows& f = rows.friction;
     const Vec3& n = rows.dir[0];
     for (int k = 0; k < 3; ++k) {
@@ -125,30 +135,10 @@ class Solver {
     f.radius /= c.count;
   }
 
-  /// The normal block of `rows` (ContactRows): D, G, P G, P Dᵀ target and the columns C.
-  void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
-                     const SolverBody* b, double dt) const {
-    Mat3 P = Mat3::Zero();
-    if (c.count == 1) {
-      rows.D.setZero(1, 3);
-      rows.D(0, 0) = 1.0;
-      P(0, 0) = c.points[0].normal_mass;
-    } else {
-      const NormalSystem sys = normal_system_of(c, a, b);
-      rows.D = sys.D;
-      P = pseudo_inverse_factor(sys.D, sys.S);
-    }
-    Vec3 ra0 = Vec3::Zero(), rb0 = Vec3::Zero(), dt_target = Vec3::Zero();
-    for (int i = 0; i < c.count; ++i) {
-      ra0 += c.points[i].ra;
-      rb0 += c.points[i].rb;
-      dt_target += target_of(c.points[i], dt) * rows.D.row(i).transpose();
-    }
-    ra0 /= c.count;
-    rb0 /= c.count;
-    rows.G = rows.D.transpose() * rows.D;
-    rows.PG = P * rows.G;
-    rows.Pt = P * dt_target;
+  /// The normal block of `rows` (ContactRows): the columns C, D, G, P G and P Dᵀ target, with
+  /// K = D S Dᵀ formed from the columns (active_set.hpp: S = Σ Cᵀ I⁻¹ C + m⁻¹ e₀e₀ᵀ).
+  static void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
+                            const SolverBody* b, const Vec3& ra0, const Vec3& rb0, double dt) {
     const Vec3& n = rows.dir[0];
     rows.ca = {a ? Vec3(ra0.cross(n)) : Vec3::Zero(), rows.dir[1].cross(n), rows.dir[2].cross(n)};
     rows.cb = {rb0.cross(n), rows.ca[1], rows.ca[2]};
@@ -156,6 +146,28 @@ class Solver {
       rows.inv_ca[k] = a ? Vec3(a->inv_inertia * rows.ca[k]) : Vec3::Zero();
       rows.inv_cb[k] = b->inv_inertia * rows.cb[k];
     }
+    rows.D.resize(c.count, 3);
+    rows.G.setZero();
+    Vec3 dt_target = Vec3::Zero();
+    for (int i = 0; i < c.count; ++i) {
+      const Vec3 o = c.points[i].rb - rb0;
+      const Vec3 d(1.0, o.dot(rows.dir[1]), o.dot(rows.dir[2]));
+      rows.D.row(i) = d.transpose();
+      rows.G.noalias() += d * d.transpose();
+      dt_target += target_of(c.points[i], dt) * d;
+    }
+    Mat3 P = Mat3::Zero();
+    if (c.count == 1) {
+      P(0, 0) = c.points[0].normal_mass;
+    } else {
+      Mat3 S;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) S(i, j) = rows.ca[i].dot(rows.inv_ca[j]) + rows.cb[i].dot(rows.inv_cb[j]);
+      S(0, 0) += (a ? a->inv_mass : 0.0) + b->inv_mass;
+      P = pseudo_inverse_factor_of_gram(rows.G, S);
+    }
+    rows.PG = P * rows.G;
+    rows.Pt = P * dt_target;
   }
 
   int impact(Contact& c, const Vec3& gravity, double dt);
@@ -315,13 +327,15 @@ void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
 }
 
 // Friction acts on the patch as a whole (as in Bepu's and PhysX's patch friction): two
-// tangent rows at the centroid of the points, bounded together by the disc μ Σλₙ, and a twist
-// row about the normal bounded by μ Σλₙ r̄ (r̄ the points' mean distance from the centroid: the
-// torque a uniform load on those points could resist). Three rows replace two per point: a
-// face on a face had eight, which cost two thirds of each iteration. Sliding is unchanged
-// (every point slides the same way, and the bound is the same μ Σλₙ); what the patch loses is
-// the coupling of twist and slide of a load that is not centred, which per-point Coulomb
-// friction resolved only approximately anyway (at the points, not over the face).
+// tangent rows at the patch's centre of pressure, bounded together by the disc μ Σλₙ, and a
+// twist row about the normal bounded by μ Σλₙ r̄ (r̄ the points' mean distance from that
+// centre). Three rows replace two per point: a face on a face had eight, which cost two thirds
+// of each iteration. Sliding is unchanged (every point slides the same way, and the bound is
+// the same μ Σλₙ); what the patch loses is the coupling of twist and slide of an uneven load,
+// which per-point Coulomb friction resolved only at the points anyway. The centre of pressure
+// comes from the warm-started normal impulses (the points' centroid when there are none):
+// at the plain centroid, a box resting off-centre on another in a settling pile rocked and
+// slid at 0.05 m/s for tens of seconds.
 void Solver::solve_friction(Contact& c, const ContactRows& rows, Motion& a, Motion& b,
                             double ma, double mb) {
   const FrictionRows& f = rows.friction;

@@ -39,8 +39,8 @@ struct Contact {
   double friction = 0.0;          ///< Coulomb μ of the pair.
   double restitution = 0.0;       ///< e of the pair (applied to impacts only).
   int count = 0;                  ///< Points in use.
-  /// Accumulated patch friction (kept for warm starting): along t1 and t2 at the points'
-  /// centroid, N·s, and the twist about the normal, N·m·s.
+  /// Accumulated patch friction (kept for warm starting): along t1 and t2 at the patch's
+  /// centre of pressure, N·s, and the twist about the normal, N·m·s.
   std::array<double, 3> friction_impulse{};
   std::array<ContactPoint, kMaxContactPoints> points{};
 };
@@ -86,12 +86,13 @@ struct PointRows {
   Vec3 inv_b;  ///< I_b⁻¹ (rb × n), 1/(kg·m).
 };
 
-/// A contact's three friction rows: t1 and t2 at the points' centroid, the twist about n.
+/// A contact's three friction rows: t1 and t2 at the patch's centre of pressure, the twist
+/// about n.
 struct FrictionRows {
   std::array<Vec3, 3> ang_a, ang_b;  ///< r0 × t1, r0 × t2, n of each body, m (twist: 1).
   std::array<Vec3, 3> inv_a, inv_b;  ///< I⁻¹ times those, 1/(kg·m).
   std::array<double, 3> mass{};      ///< 1 / (d·K d) of each row, kg (twist: kg·m²).
-  double radius = 0.0;               ///< Mean distance of the points from their centroid, m.
+  double radius = 0.0;               ///< Mean distance of the points from that centre, m.
 };
 
 /// A contact's solver data: its directions, its points' rows and its normal block in the
