@@ -7,7 +7,9 @@
 ///                                     sweep_and_prune.cpp)
 ///   narrow_phase  → narrow_phase.cpp  box–box manifolds; box–floor manifolds of bodies in them
 ///   islands       → islands.cpp       bodies linked by contacts; a lone body is an island of one
-///   contact_solve → contact_solver.cpp impacts, friction, non-penetration of the islands
+///   contact_solve → contact_solve.cpp  impacts, friction, non-penetration of the islands (the
+///                                     solver: contact_solver.cpp, contact_rows.cpp,
+///                                     shock_propagation.cpp)
 ///   flight        → flight.cpp        every awake body moved over dt
 ///   finalize      → finalize.cpp      finiteness (freeze) and re-orthonormalisation
 ///   update_sleep  → sleep.cpp         one rule: an island still for long enough sleeps

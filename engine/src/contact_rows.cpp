@@ -1,0 +1,106 @@
+/// The contact solver's rows of one step (Solver::prepare): each point's offsets and normal
+/// row, the normal block in the patch's coordinates and the patch friction rows.
+#include "solver.hpp"
+
+namespace tumble {
+namespace {
+
+/// The patch friction rows of `rows` (FrictionRows): the tangents at the point ra0, rb0 (m,
+/// from the centres) and the twist about the normal.
+void prepare_friction(const Contact& c, ContactRows& rows, const SolverBody* a,
+                      const SolverBody* b, const Vec3& ra0, const Vec3& rb0) {
+  FrictionRows& f = rows.friction;
+  const Vec3& n = rows.dir[0];
+  for (int k = 0; k < 3; ++k) {
+    f.ang_a[k] = !a ? Vec3::Zero() : k < 2 ? Vec3(ra0.cross(rows.dir[k + 1])) : n;
+    f.ang_b[k] = k < 2 ? Vec3(rb0.cross(rows.dir[k + 1])) : n;
+    f.inv_a[k] = a ? Vec3(a->inv_inertia * f.ang_a[k]) : Vec3::Zero();
+    f.inv_b[k] = b->inv_inertia * f.ang_b[k];
+    const double linear = k < 2 ? (a ? a->inv_mass : 0.0) + b->inv_mass : 0.0;
+    f.mass[k] = 1.0 / (linear + f.ang_a[k].dot(f.inv_a[k]) + f.ang_b[k].dot(f.inv_b[k]));
+  }
+  f.radius = 0.0;
+  for (int i = 0; i < c.count; ++i) {
+    const Vec3 o = c.points[i].rb - rb0;
+    f.radius += (o - o.dot(n) * n).norm();
+  }
+  f.radius /= c.count;
+}
+
+/// The normal block of `rows` (ContactRows): the columns C, D, G, P G and P Dᵀ target, with
+/// K = D S Dᵀ formed from the columns (active_set.hpp: S = Σ Cᵀ I⁻¹ C + m⁻¹ e₀e₀ᵀ).
+void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
+                   const SolverBody* b, const Vec3& ra0, const Vec3& rb0, double dt) {
+  const Vec3& n = rows.dir[0];
+  rows.ca = {a ? Vec3(ra0.cross(n)) : Vec3::Zero(), rows.dir[1].cross(n), rows.dir[2].cross(n)};
+  rows.cb = {rb0.cross(n), rows.ca[1], rows.ca[2]};
+  for (int k = 0; k < 3; ++k) {
+    rows.inv_ca[k] = a ? Vec3(a->inv_inertia * rows.ca[k]) : Vec3::Zero();
+    rows.inv_cb[k] = b->inv_inertia * rows.cb[k];
+  }
+  rows.D.resize(c.count, 3);
+  rows.G.setZero();
+  Vec3 dt_target = Vec3::Zero();
+  for (int i = 0; i < c.count; ++i) {
+    const Vec3 o = c.points[i].rb - rb0;
+    const Vec3 d(1.0, o.dot(rows.dir[1]), o.dot(rows.dir[2]));
+    rows.D.row(i) = d.transpose();
+    rows.G.noalias() += d * d.transpose();
+    dt_target += Solver::target_of(c.points[i], dt) * d;
+  }
+  Mat3 P = Mat3::Zero();
+  if (c.count == 1) {
+    P(0, 0) = c.points[0].normal_mass;
+  } else {
+    Mat3 S;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) S(i, j) = rows.ca[i].dot(rows.inv_ca[j]) + rows.cb[i].dot(rows.inv_cb[j]);
+    S(0, 0) += (a ? a->inv_mass : 0.0) + b->inv_mass;
+    P = pseudo_inverse_factor_of_gram(rows.G, S);
+  }
+  rows.PG = P * rows.G;
+  rows.Pt = P * dt_target;
+}
+
+}  // namespace
+
+void Solver::prepare(Contact& c, std::size_t n, double dt) {
+  SolverBody* a = body(c.a);
+  SolverBody* b = body(c.b);
+  ContactRows& block = rows_[n];  // sized by the caller
+  tangents(c.normal, block.dir[1], block.dir[2]);
+  block.dir[0] = c.normal;
+  const Vec3& normal = c.normal;
+  Vec3 ra0 = Vec3::Zero(), rb0 = Vec3::Zero();  // the points' centroid from each centre
+  for (int i = 0; i < c.count; ++i) {
+    ContactPoint& p = c.points[i];
+    p.ra = c.a == kStaticBody ? p.position : Vec3(p.position - bodies_[c.a].s.x);
+    p.rb = p.position - bodies_[c.b].s.x;
+    p.pseudo_impulse = 0.0;
+    ra0 += p.ra;
+    rb0 += p.rb;
+    PointRows& r = block.points[i];
+    r.ang_a = a ? Vec3(p.ra.cross(normal)) : Vec3::Zero();
+    r.inv_a = a ? Vec3(a->inv_inertia * r.ang_a) : Vec3::Zero();
+    r.ang_b = p.rb.cross(normal);
+    r.inv_b = b->inv_inertia * r.ang_b;
+    const double k = (a ? a->inv_mass + r.ang_a.dot(r.inv_a) : 0.0) + b->inv_mass +
+                     r.ang_b.dot(r.inv_b);  // n·K n, 1/kg
+    p.normal_mass = 1.0 / k;
+  }
+  ra0 /= c.count;
+  rb0 /= c.count;
+  prepare_block(c, block, a, b, ra0, rb0, dt);
+  // Friction acts at the patch's centre of pressure (see solve_friction).
+  double load = 0.0;
+  Vec3 ra_load = Vec3::Zero(), rb_load = Vec3::Zero();
+  for (int i = 0; i < c.count; ++i) {
+    load += c.points[i].normal_impulse;
+    ra_load += c.points[i].normal_impulse * c.points[i].ra;
+    rb_load += c.points[i].normal_impulse * c.points[i].rb;
+  }
+  if (load > 0.0) prepare_friction(c, block, a, b, ra_load / load, rb_load / load);
+  else prepare_friction(c, block, a, b, ra0, rb0);
+}
+
+}  // namespace tumble

@@ -1,0 +1,147 @@
+#pragma once
+/// The contact solver's working object, shared by the files of the solve (contact_solver.cpp,
+/// contact_rows.cpp, shock_propagation.cpp); not part of the engine's interface.
+#include <cmath>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "active_set.hpp"
+#include "contact_solver.hpp"
+#include "worker_pool.hpp"
+
+namespace tumble {
+
+/// Two unit tangents completing n to a right-handed basis, chosen the same way every step so
+/// accumulated friction impulses stay meaningful for warm starting.
+inline void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  const Vec3 ref = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  t1 = n.cross(ref).normalized();
+  t2 = n.cross(t1);
+}
+
+/// A body's velocities during one contact's sweep (m/s, rad/s).
+struct Motion {
+  Vec3 v;
+  Vec3 w;
+};
+
+/// One step's contact solve over the solver bodies: their velocities, the contacts' rows and
+/// the passes of solve_contacts (contact_solver.cpp), the rows (contact_rows.cpp) and shock
+/// propagation (shock_propagation.cpp). Lives for one call of solve_contacts; its buffers are
+/// the caller's SolverScratch. A pass over contacts of one colour may run on several threads.
+class Solver {
+ public:
+  /// The solver bodies of `ids` with their velocities at the step start, gravity's
+  /// `gravity_dv` (m/s) added to v.
+  Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch,
+         WorkerPool& pool, const Vec3& gravity_dv)
+      : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
+        rows_(scratch.rows), fixed_(scratch.fixed), order_(scratch.order),
+        waves_(scratch.waves), wave_of_(scratch.wave_of), wave_start_(scratch.wave_start),
+        wave_order_(scratch.wave_order), group_start_(scratch.group_start) {
+    index_.resize(bodies.size(), -1);
+    fixed_ = SolverBody{};
+    sb_.resize(ids.size());
+    pool.for_each(ids.size(), 128, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const Body& b = bodies[ids[k]];
+        index_[ids[k]] = static_cast<std::int32_t>(k);
+        sb_[k] = SolverBody{};
+        sb_[k].inv_mass = b.c.inv_mass;
+        sb_[k].inv_inertia = inverse_inertia_world(b.s, b.c);
+        sb_[k].v = b.s.P * b.c.inv_mass;
+        sb_[k].w = sb_[k].inv_inertia * b.s.L;
+        sb_[k].v += gravity_dv;
+      }
+    });
+  }
+
+  SolverBody* body(std::uint32_t id) { return id == kStaticBody ? nullptr : &sb_[index_[id]]; }
+
+  static Vec3 point_velocity(const SolverBody* s, const Vec3& r) {
+    return s ? Vec3(s->v + s->w.cross(r)) : Vec3::Zero();
+  }
+  static Vec3 pseudo_velocity(const SolverBody* s, const Vec3& r) {
+    return s ? Vec3(s->vp + s->wp.cross(r)) : Vec3::Zero();
+  }
+  /// Impulse j (N·s) on b at rb, −j on a at ra.
+  static void apply(SolverBody* a, SolverBody* b, const Vec3& ra, const Vec3& rb, const Vec3& j) {
+    if (a) a->v -= a->inv_mass * j, a->w -= a->inv_inertia * ra.cross(j);
+    if (b) b->v += b->inv_mass * j, b->w += b->inv_inertia * rb.cross(j);
+  }
+  static void apply_pseudo(SolverBody* a, SolverBody* b, const Vec3& ra, const Vec3& rb,
+                           const Vec3& j) {
+    if (a) a->vp -= a->inv_mass * j, a->wp -= a->inv_inertia * ra.cross(j);
+    if (b) b->vp += b->inv_mass * j, b->wp += b->inv_inertia * rb.cross(j);
+  }
+  /// The step's rows of contact `c` (its n-th): the points' offsets and normal rows, the
+  /// normal block and the patch friction (contact_rows.cpp). Thread-safe across contacts.
+  void prepare(Contact& c, std::size_t n, double dt);
+
+  int impact(Contact& c, const Vec3& gravity, double dt);
+  void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
+                         WorkerPool& pool);
+  void push_up(Contact& c, const Vec3& up, double dt);
+  void push_up_body(std::span<Contact> contacts,
+                    std::span<const std::pair<double, std::uint32_t>> group, const Vec3& up,
+                    double dt);
+  /// The body a support contact holds up (the one the normal, oriented up, points into).
+  static std::uint32_t upper_of(const Contact& c, const Vec3& up) {
+    return c.normal.dot(up) > 0.0 ? c.b : c.a;
+  }
+  /// K = D S Dᵀ, K_ij = n·(change of the relative normal velocity at point i per unit impulse
+  /// at j), 1/kg; a or b null: that body is held fixed.
+  static NormalSystem normal_system_of(const Contact& c, const SolverBody* a,
+                                       const SolverBody* b);
+  void warm_start(Contact& c, std::size_t index);
+  void solve_velocity(Contact& c, std::size_t index, double dt);
+  void solve_position(Contact& c, std::size_t index, const SolverSettings& s, double dt);
+  /// The solver body of id, or the fixed stand-in for the floor.
+  SolverBody& side(std::uint32_t id) { return id == kStaticBody ? fixed_ : sb_[index_[id]]; }
+  /// Relative normal velocity of b over a at a point (row r, normal n), m/s. Body: anything
+  /// with velocities v and w (a SolverBody, or a Motion held in registers).
+  template <typename Body>
+  static double normal_speed(const Body& a, const Body& b, const Vec3& n, const PointRows& r) {
+    return n.dot(b.v - a.v) + b.w.dot(r.ang_b) - a.w.dot(r.ang_a);
+  }
+  /// Normal impulse j (N·s) at a point: +j n on b, −j n on a (inverse masses ma, mb in 1/kg;
+  /// ma = 0: a is the floor and keeps its zero velocity).
+  template <typename Body>
+  static void push(Body& a, Body& b, double ma, double mb, const Vec3& n, const PointRows& r,
+                   double j) {
+    if (j == 0.0) return;
+    if (ma > 0.0) {
+      a.v -= (ma * j) * n;
+      a.w -= j * r.inv_a;
+    }
+    b.v += (mb * j) * n;
+    b.w += j * r.inv_b;
+  }
+  /// Writes the end-of-step momenta P = m v, L = I w (I at the step start) of solver bodies
+  /// [begin, end).
+  void finish(std::size_t begin, std::size_t end);
+  /// Forgets the body index, so the next step starts from an index of −1 only.
+  void release();
+  /// Normal velocity a point must reach: a speculative point may close its gap within the
+  /// step, a touching one may not approach (its penetration is the split impulse's job).
+  static double target_of(const ContactPoint& p, double dt) {
+    return p.separation > 0.0 ? -p.separation / dt : 0.0;
+  }
+
+ private:
+  std::span<Body> bodies_;
+  std::span<const std::uint32_t> ids_;
+  std::vector<std::int32_t>& index_;
+  std::vector<SolverBody>& sb_;
+  std::vector<ContactRows>& rows_;  // solver rows of each contact
+  SolverBody& fixed_;               // the floor: absorbs impulses without moving
+  std::vector<std::pair<double, std::uint32_t>>& order_;
+  std::vector<std::uint32_t>& waves_;       // latest shock-propagation wave of each body
+  std::vector<std::uint32_t>& wave_of_;     // wave of each group
+  std::vector<std::uint32_t>& wave_start_;  // start of each wave in wave_order_
+  std::vector<std::uint32_t>& wave_order_;  // solves (groups), wave by wave
+  std::vector<std::uint32_t>& group_start_;  // start of each body's supports in order_
+};
+
+}  // namespace tumble
