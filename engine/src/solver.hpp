@@ -57,32 +57,31 @@ class Solver {
     });
   }
 
+  /// The solver body of id, or null for the floor.
   SolverBody* body(std::uint32_t id) { return id == kStaticBody ? nullptr : &sb_[index_[id]]; }
 
+  /// Velocity of the point at r from the centre of s (zero for the floor), m/s.
   static Vec3 point_velocity(const SolverBody* s, const Vec3& r) {
     return s ? Vec3(s->v + s->w.cross(r)) : Vec3::Zero();
-  }
-  static Vec3 pseudo_velocity(const SolverBody* s, const Vec3& r) {
-    return s ? Vec3(s->vp + s->wp.cross(r)) : Vec3::Zero();
   }
   /// Impulse j (N·s) on b at rb, −j on a at ra.
   static void apply(SolverBody* a, SolverBody* b, const Vec3& ra, const Vec3& rb, const Vec3& j) {
     if (a) a->v -= a->inv_mass * j, a->w -= a->inv_inertia * ra.cross(j);
     if (b) b->v += b->inv_mass * j, b->w += b->inv_inertia * rb.cross(j);
   }
-  static void apply_pseudo(SolverBody* a, SolverBody* b, const Vec3& ra, const Vec3& rb,
-                           const Vec3& j) {
-    if (a) a->vp -= a->inv_mass * j, a->wp -= a->inv_inertia * ra.cross(j);
-    if (b) b->vp += b->inv_mass * j, b->wp += b->inv_inertia * rb.cross(j);
-  }
   /// The step's rows of contact `c` (its n-th): the points' offsets and normal rows, the
   /// normal block and the patch friction (contact_rows.cpp). Thread-safe across contacts.
   void prepare(Contact& c, std::size_t n, double dt);
 
+  /// The collision pass of contact c: its fast-approaching points' exact impulses; 1 when it
+  /// had an impact, else 0.
   int impact(Contact& c, const Vec3& gravity, double dt);
+  /// The ground-up pass over the contacts after the iterations (shock_propagation.cpp).
   void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
                          WorkerPool& pool);
+  /// Shock propagation of one support contact: its lower body held fixed.
   void push_up(Contact& c, const Vec3& up, double dt);
+  /// Shock propagation of one body on all its supports (`group` of contacts) at once.
   void push_up_body(std::span<Contact> contacts,
                     std::span<const std::pair<double, std::uint32_t>> group, const Vec3& up,
                     double dt);
@@ -94,8 +93,11 @@ class Solver {
   /// at j), 1/kg; a or b null: that body is held fixed.
   static NormalSystem normal_system_of(const Contact& c, const SolverBody* a,
                                        const SolverBody* b);
+  /// Applies contact c's accumulated impulses (its index-th rows) to its bodies.
   void warm_start(Contact& c, std::size_t index);
+  /// One sequential-impulse sweep of contact c: patch friction, then the normal block.
   void solve_velocity(Contact& c, std::size_t index, double dt);
+  /// One split-impulse sweep of contact c on the pseudo velocities.
   void solve_position(Contact& c, std::size_t index, const SolverSettings& s, double dt);
   /// The solver body of id, or the fixed stand-in for the floor.
   SolverBody& side(std::uint32_t id) { return id == kStaticBody ? fixed_ : sb_[index_[id]]; }
