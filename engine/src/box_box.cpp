@@ -263,11 +263,11 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
   const double best_face = std::max(best_a, best_b);
   const double edge_tolerance =
       kEdgeTolerance + kEdgeRelativeTolerance * std::min(ha.minCoeff(), hb.minCoeff());
-  if (edge_i >= 0 && best_edge > best_face + edge_tolerance &&
-      edge_contact(a, ca, b, cb, edge_i, edge_j, a.R.col(edge_i).cross(b.R.col(edge_j)).normalized(),
-                   m) &&
-      m.points[0].separation < margin)
-    return m;
+  if (edge_i >= 0 && best_edge > best_face + edge_tolerance) {
+    const Vec3 axis = a.R.col(edge_i).cross(b.R.col(edge_j)).normalized();
+    if (edge_contact(a, ca, b, cb, edge_i, edge_j, axis, m) && m.points[0].separation < margin)
+      return m;
+  }
   m = BoxManifold{};
 
   std::array<ManifoldPoint, kMaxClipped> clipped{};

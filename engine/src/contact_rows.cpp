@@ -54,7 +54,8 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
   } else {
     Mat3 S;
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) S(i, j) = rows.ca[i].dot(rows.inv_ca[j]) + rows.cb[i].dot(rows.inv_cb[j]);
+      for (int j = 0; j < 3; ++j)
+        S(i, j) = rows.ca[i].dot(rows.inv_ca[j]) + rows.cb[i].dot(rows.inv_cb[j]);
     S(0, 0) += (a ? a->inv_mass : 0.0) + b->inv_mass;
     P = pseudo_inverse_factor_of_gram(rows.G, S);
   }
