@@ -9,6 +9,7 @@ const kFrozenTint = new THREE.Color(0xff4d4d);
 const kEdgeColor = new THREE.Color(0x0b0d10);
 const kFrozenEdgeColor = new THREE.Color(0xff3030);
 const kMaxShadowExtent = 60; // m: beyond this the shadow map would be too coarse to be useful.
+const kShadowFitFrames = 25; // frames between two fits of the shadow map to the bodies.
 const kMaxLabels = 16;
 const kKickMs = 700; // lifetime of the kick arrow
 /** Lowest the camera may look from: just above the horizontal plane through its target, rad. */
@@ -291,11 +292,14 @@ export class Viewer {
     this.boxes.visible = this.edges.visible = true;
     this.hasPose = true;
 
+    // The shadow map follows the bodies every kShadowFitFrames frames, and at once when the
+    // camera is framed anew: a page must not show one shadow at load and another 25 frames on.
     if (this.needsFit) {
       this.#fitCamera();
       this.needsFit = false;
+      this.framesSinceShadowFit = kShadowFitFrames;
     }
-    if (++this.framesSinceShadowFit >= 25) {
+    if (++this.framesSinceShadowFit >= kShadowFitFrames) {
       this.framesSinceShadowFit = 0;
       const sphere = this.#bodiesSphere();
       if (sphere) this.#fitShadow(sphere.center, sphere.radius);
