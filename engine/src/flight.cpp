@@ -39,12 +39,16 @@ void flight(StepContext& ctx) {
   // impact and resting contact handled exactly (floor_contact.cpp).
   // Each lone body's start state is kept for finalize here, where it is read anyway.
   BodyState* before = s.before.data() + s.solver_bodies.size();
+  // Each lone body's turn is kept for the next step in the slot of its place in the list (a
+  // slot that changes body is recomputed: the cache is keyed by the turn's angle alone), so
+  // the memory follows the bodies in flight, 104 bytes each, not the world's size.
+  if (s.spins.size() < s.lone_bodies.size()) s.spins.resize(s.lone_bodies.size());
   ctx.pool.for_each(s.lone_bodies.size(), kLoneGrain, [&](std::size_t begin, std::size_t end) {
     std::uint32_t impacts = 0, iterations = 0;
     for (std::size_t k = begin; k < end; ++k) {
       Body& b = ctx.bodies[s.lone_bodies[k]];
       before[k] = b.s;
-      const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt);
+      const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt, &s.spins[k]);
       impacts += static_cast<std::uint32_t>(r.impacts);
       iterations += static_cast<std::uint32_t>(r.toi_iterations);
       b.in_contact = r.touched;

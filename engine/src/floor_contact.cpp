@@ -464,16 +464,16 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
 // Most steps of most bodies are in flight, clear of the floor: that case is one call of the
 // integrator and two comparisons, kept apart from the contact code (whose stack frame and
 // saved registers were a third of the instructions of a cube's flight).
-FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt) {
+FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin) {
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
   if (!w.floor) {
-    s = advance(w.integrator, s, c, w.gravity, dt);
+    s = advance(w.integrator, s, c, w.gravity, dt, spin);
     return {};
   }
   const double floor_y = w.floor->height;
   if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr);
-  const BodyState next = advance(w.integrator, s, c, w.gravity, dt);
+  const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin);
   if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next);
   s = next;
   return {};

@@ -1,6 +1,7 @@
 #pragma once
 /// Bodies against the floor plane y = h: time of impact, impulses, resting contact.
 /// Pure functions over one body; thread-safe.
+#include "integrators.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
 
@@ -33,7 +34,9 @@ bool at_rest_on_face(const BodyState& s, const BodyConstants& c, double floor_he
 
 /// Advances one awake body by dt: flight with the world's integrator, impacts located by
 /// the world's TOI method and answered with impulses, resting contact without sinking.
-FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt);
+/// `spin` (may be null) keeps a cube's turn between steps (integrators.hpp).
+FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt,
+                                   SpinCache* spin = nullptr);
 
 /// Applies simultaneous impulses at the vertices touching the floor (within 1e-9 m of the
 /// lowest) so that no contact approaches: restitution e, Coulomb friction μ. Returns the

@@ -1,5 +1,7 @@
 #include "integrators.hpp"
 
+#include <cstring>
+
 #include "free_rotation.hpp"
 
 namespace tumble {
@@ -66,12 +68,27 @@ BodyState symplectic_euler(const BodyState& s, const BodyConstants& c, const Vec
   return r;
 }
 
+/// A cube's turn by `angle`, from `spin` when it holds that angle bit for bit (±0 differ:
+/// the turn's zero entries keep their signs, so a copied World without the cache agrees).
+const Mat3& cube_turn(const Vec3& angle, SpinCache& spin) {
+  if (!spin.held || std::memcmp(angle.data(), spin.angle.data(), sizeof(double) * 3) != 0) {
+    spin.turn = rotation_from_vector(angle);
+    spin.angle = angle;
+    spin.held = true;
+  }
+  return spin.turn;
+}
+
 /// The torque-free rotation over h of the `exact` and `splitting` integrators.
-Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants& c, double h) {
+Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants& c, double h,
+                 SpinCache* spin) {
   if (s.L.isZero()) return s.R;  // No spin: nothing to rotate.
   // A cube: ω = L / I is constant, the flow is one rotation (exact for both methods).
-  if (c.shape == InertiaShape::isotropic)
-    return rotation_from_vector((h * c.inv_inertia.x()) * s.L) * s.R;
+  if (c.shape == InertiaShape::isotropic) {
+    const Vec3 angle = (h * c.inv_inertia.x()) * s.L;
+    if (spin) return cube_turn(angle, *spin) * s.R;
+    return rotation_from_vector(angle) * s.R;
+  }
   if (integrator == Integrator::exact) return free_rotation_exact(c.inertia, s.R, s.L, h);
   return free_rotation_splitting(c.inertia, s.R, s.L, h);
 }
@@ -93,14 +110,14 @@ Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants&
 }  // namespace
 
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h) {
+                  const Vec3& gravity, double h, SpinCache* spin) {
   if (integrator != Integrator::exact && integrator != Integrator::splitting)
     return advance_in_stages(integrator, s, c, gravity, h);
   // Ballistic translation in closed form, x(h) = x + v h + ½ g h², P(h) = P + m g h, and the
   // torque-free rotation; every field written once (no default state built and overwritten:
   // this is the whole step of a body in flight).
   return {s.x + h * (c.inv_mass * s.P) + (0.5 * h * h) * gravity,
-          torque_free(integrator, s, c, h), s.P + (h * c.mass) * gravity, s.L};
+          torque_free(integrator, s, c, h, spin), s.P + (h * c.mass) * gravity, s.L};
 }
 
 }  // namespace tumble

@@ -17,7 +17,18 @@ namespace tumble {
 /// 64 steps keeps ‖RᵀR − I‖ near 1e-15 at a sixty-fourth of the cost.
 inline constexpr std::uint64_t kGramSchmidtInterval = 64;
 
+/// The turn of a cube (an isotropic body) in one step of torque-free flight, kept between
+/// steps: ω = L / I is constant in flight, so the turn exp(h ω×) is the same matrix step after
+/// step, and it is recomputed only when h ω changes. The same bits as computing it afresh.
+/// One per body; not thread-safe (each body's cache is used by one thread at a time).
+struct SpinCache {
+  Vec3 angle = Vec3::Zero();     ///< h ω it holds, rad.
+  Mat3 turn = Mat3::Identity();  ///< rotation_from_vector(angle).
+  bool held = false;             ///< Whether it holds a turn yet.
+};
+
+/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null).
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h);
+                  const Vec3& gravity, double h, SpinCache* spin = nullptr);
 
 }  // namespace tumble

@@ -25,6 +25,7 @@
 #include "box_box.hpp"
 #include "broad_phase.hpp"
 #include "contact_solver.hpp"
+#include "integrators.hpp"
 #include "islands.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
@@ -87,6 +88,7 @@ struct StepScratch {
   std::vector<std::uint32_t> stepped;        ///< solver_bodies then lone_bodies.
   std::vector<BodyState> before;             ///< State of stepped[k] at the step start.
   SolverScratch solver;                      ///< The contact solver's per-body data.
+  std::vector<SpinCache> spins;              ///< The turn of lone_bodies[k] in flight (a cube's).
 };
 
 /// Everything a stage reads and writes.
