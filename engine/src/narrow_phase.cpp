@@ -12,13 +12,14 @@ namespace {
 // near each other keep the lone path with the scene's exact integrator.
 constexpr double kTouchDistance = 1e-3;
 
-/// The velocities of a body, m/s and rad/s.
-struct Motion {
-  Vec3 v;
-  Vec3 w;
-};
+using Motion = BodyVelocity;
 
 Motion motion_of(const Body& b) { return {b.s.P * b.c.inv_mass, angular_velocity(b.s, b.c)}; }
+
+/// Body i's velocities: those found for the step when `shared` and i is awake, else afresh.
+Motion motion(const StepContext& ctx, std::uint32_t i, bool shared) {
+  return shared && ctx.broad.active[i] ? ctx.scratch.velocities[i] : motion_of(ctx.bodies[i]);
+}
 
 /// True when some point of the manifold touches or will touch within dt.
 bool touches(const BoxManifold& m, const Body& a, const Motion& ma, const Body& b,
@@ -53,10 +54,10 @@ void write_contact(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const
 }
 
 /// The manifold of pair p, or none (count 0) when its boxes will not touch within the step.
-BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p) {
+BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared) {
   const Body& a = ctx.bodies[p.first];
   const Body& b = ctx.bodies[p.second];
-  const Motion ma = motion_of(a), mb = motion_of(b);
+  const Motion ma = motion(ctx, p.first, shared), mb = motion(ctx, p.second, shared);
   const double closing = ctx.dt * ((ma.v - mb.v).norm() + ma.w.norm() * a.c.bounding_radius +
                                    mb.w.norm() * b.c.bounding_radius);
   BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
@@ -79,9 +80,22 @@ std::uint32_t number_slots(std::size_t n, std::vector<std::int32_t>& slot, Has&&
 void collide_pairs(StepContext& ctx) {
   constexpr std::size_t kGrain = 16;  // pairs per chunk: 0.2–1 µs each
   StepScratch& s = ctx.scratch;
+  // Each awake body's velocities (ω = R I⁻¹ Rᵀ L) are found once for the step when the pairs
+  // are at least half as many as the awake bodies: a pile has ~7 pairs per body, each of
+  // which read both bodies' (4 % of `pile`'s instructions). 10,000 bodies in flight with a
+  // few pairs find them pair by pair. The same function either way: the same bits.
+  const std::vector<std::uint32_t>& awake = ctx.broad.awake;
+  const bool shared = 2 * s.pairs.size() >= awake.size() && !s.pairs.empty();
+  if (shared) {
+    s.velocities.resize(ctx.bodies.size());
+    ctx.pool.for_each(awake.size(), 256, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k)
+        s.velocities[awake[k]] = motion_of(ctx.bodies[awake[k]]);
+    });
+  }
   s.manifolds.resize(s.pairs.size());
   ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) s.manifolds[k] = manifold_of(ctx, s.pairs[k]);
+    for (std::size_t k = begin; k < end; ++k) s.manifolds[k] = manifold_of(ctx, s.pairs[k], shared);
   });
   const std::uint32_t count = number_slots(s.pairs.size(), s.slot,
                                            [&](std::size_t k) { return s.manifolds[k].count > 0; });

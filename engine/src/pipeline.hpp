@@ -69,6 +69,12 @@ struct BroadPhaseCache {
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
 };
 
+/// A body's velocities, m/s and rad/s.
+struct BodyVelocity {
+  Vec3 v;
+  Vec3 w;
+};
+
 /// Buffers of one step, reused between steps so that a step allocates nothing once warm.
 /// Holds no result: a World's copy starts with empty scratch.
 struct StepScratch {
@@ -76,6 +82,7 @@ struct StepScratch {
   std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
   std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.
   std::vector<BoxManifold> manifolds;   ///< Manifold of each pair (count 0: no contact).
+  std::vector<BodyVelocity> velocities; ///< Awake bodies' velocities (narrow phase, by body).
   std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
   std::vector<std::int32_t> slot;       ///< Position of each pair's (body's) contact, or −1.
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
