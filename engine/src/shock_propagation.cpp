@@ -94,12 +94,13 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     wave_order_[wave_start_[wave_of_[gi]]++] = static_cast<std::uint32_t>(gi);
   for (std::size_t w = wave_start_.size() - 1; w > 0; --w) wave_start_[w] = wave_start_[w - 1];
   wave_start_[0] = 0;
-  for (std::uint32_t w = 1; w <= last; ++w) {
-    const std::size_t begin = wave_start_[w], end = wave_start_[w + 1];
-    pool.for_each(end - begin, 16, [&](std::size_t from, std::size_t to) {
-      for (std::size_t k = begin + from; k < begin + to; ++k) solve_group(wave_order_[k]);
-    });
-  }
+  // Waves 1 … last are the phases of one job (pool.for_each_phase).
+  pool.for_each_phase(
+      last, 4, [&](std::size_t p) { return wave_start_[p + 2] - wave_start_[p + 1]; },
+      [&](std::size_t p, std::size_t from, std::size_t to) {
+        const std::size_t begin = wave_start_[p + 1];
+        for (std::size_t k = begin + from; k < begin + to; ++k) solve_group(wave_order_[k]);
+      });
 }
 
 /// Shock propagation of one body on its supports (`group`: (height, contact) entries whose

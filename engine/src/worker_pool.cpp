@@ -73,6 +73,37 @@ void WorkerPool::run(std::size_t n, std::size_t grain, Thunk thunk, void* fn) {
   }
 }
 
+// A for_each_phase job is a for_each job of one index per thread, each of which runs the
+// phases: any thread that joins takes chunks of the current phase, and one that finds no chunk
+// left waits for the phase's last chunk to finish before it moves on. A thread that runs the
+// phases again (a late worker, or the caller taking a second index) finds every chunk taken
+// and only passes through. The caller runs every phase itself when no worker joins.
+void WorkerPool::run_phases(PhaseThunk thunk, void* fn) {
+  phase_thunk_ = thunk;
+  phase_fn_ = fn;
+  run(size(), 1, [](void* pool, std::size_t, std::size_t) {
+    static_cast<WorkerPool*>(pool)->work_phases();
+  }, this);
+}
+
+void WorkerPool::work_phases() {
+  for (std::size_t p = 0; p < phase_count_; ++p) {
+    Phase& ph = phases_[p];
+    for (;;) {
+      const std::size_t c = ph.next.fetch_add(1, std::memory_order_relaxed);
+      if (c >= ph.chunks) break;
+      const std::size_t begin = c * ph.chunk;
+      phase_thunk_(phase_fn_, p, begin, std::min(ph.n, begin + ph.chunk));
+      ph.done.fetch_add(1, std::memory_order_release);
+    }
+    // Every chunk of phase p is taken; wait until they are done (their writes visible).
+    for (int spins = 0; ph.done.load(std::memory_order_acquire) < ph.chunks; ++spins) {
+      if (spins < kSpinRounds) cpu_relax();
+      else std::this_thread::yield();
+    }
+  }
+}
+
 void WorkerPool::work() {
   for (;;) {
     const std::size_t c = next_.fetch_add(1, std::memory_order_relaxed);

@@ -4,10 +4,12 @@
 /// on the thread count as long as each index writes only its own outputs (every stage that
 /// uses the pool is written that way), so a World steps bit-identically on 1 or N threads.
 /// One thread (the World's owner) submits work; the pool itself is not re-entrant.
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -40,7 +42,54 @@ class WorkerPool {
     run(n, grain, &call<Fn>, &fn);
   }
 
+  /// Calls fn(phase, begin, end) over [0, size(phase)) for phase = 0 … phases − 1 in turn,
+  /// each phase in chunks of at least `grain` shared among the threads; a phase starts on any
+  /// thread only once every chunk of the one before is done. One job for all the phases: a
+  /// thread waits between phases on a counter (a fraction of a microsecond) where a job per
+  /// phase cost the caller a publication, a close and a thread's idle chunk each. `size` is
+  /// called once per phase, on the caller. Allocates only when `phases` grows.
+  template <typename Size, typename Fn>
+  void for_each_phase(std::size_t phases, std::size_t grain, Size&& size, Fn&& fn) {
+    if (workers_.empty()) {
+      for (std::size_t p = 0; p < phases; ++p) fn(p, std::size_t{0}, static_cast<std::size_t>(size(p)));
+      return;
+    }
+    plan_phases(phases, grain, [&](std::size_t p) { return static_cast<std::size_t>(size(p)); });
+    run_phases(&call_phase<Fn>, &fn);
+  }
+
  private:
+  /// One phase of a for_each_phase job: its chunks, the next one to take and those done.
+  struct Phase {
+    std::size_t n = 0, chunk = 1, chunks = 0;
+    alignas(64) std::atomic<std::size_t> next{0};
+    alignas(64) std::atomic<std::size_t> done{0};
+  };
+  using PhaseThunk = void (*)(void*, std::size_t, std::size_t, std::size_t);
+  template <typename Fn>
+  static void call_phase(void* fn, std::size_t phase, std::size_t begin, std::size_t end) {
+    (*static_cast<Fn*>(fn))(phase, begin, end);
+  }
+  template <typename Size>
+  void plan_phases(std::size_t phases, std::size_t grain, Size&& size) {
+    if (phase_capacity_ < phases) {
+      phase_capacity_ = std::max(phases, 2 * phase_capacity_);
+      phases_ = std::make_unique<Phase[]>(phase_capacity_);
+    }
+    phase_count_ = phases;
+    const std::size_t most = 4 * static_cast<std::size_t>(this->size());
+    for (std::size_t p = 0; p < phases; ++p) {
+      Phase& ph = phases_[p];
+      ph.n = size(p);
+      ph.chunk = std::max<std::size_t>(std::max<std::size_t>(grain, 1), (ph.n + most - 1) / most);
+      ph.chunks = (ph.n + ph.chunk - 1) / ph.chunk;
+      ph.next.store(0, std::memory_order_relaxed);
+      ph.done.store(0, std::memory_order_relaxed);
+    }
+  }
+  void run_phases(PhaseThunk thunk, void* fn);
+  void work_phases();
+
   using Thunk = void (*)(void*, std::size_t, std::size_t);
   template <typename Fn>
   static void call(void* fn, std::size_t begin, std::size_t end) {
@@ -50,6 +99,11 @@ class WorkerPool {
   void work();
   void worker_main();
 
+  std::unique_ptr<Phase[]> phases_;  // the phases of the current for_each_phase job
+  std::size_t phase_capacity_ = 0;
+  std::size_t phase_count_ = 0;
+  PhaseThunk phase_thunk_ = nullptr;
+  void* phase_fn_ = nullptr;
   std::vector<std::thread> workers_;
   // The job: written by the caller while no worker has joined, read by workers that joined it.
   Thunk thunk_ = nullptr;

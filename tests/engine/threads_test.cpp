@@ -65,6 +65,43 @@ TEST(Threads, EveryIndexRunsOnce) {
   }
 }
 
+// for_each_phase: every index of every phase once, and a phase sees all of the one before.
+// Each index of phase p adds one to the sum of three entries phase p − 1 wrote; a phase that
+// began before the last finished would read a stale entry and the totals would differ.
+TEST(Threads, PhasesRunInTurnAndEveryIndexOnce) {
+  constexpr std::size_t kPhases = 60;
+  auto size = [](std::size_t p) { return std::size_t{1 + (p * 37) % 97}; };  // 1 to 97 indices
+  std::vector<std::vector<long>> expected(kPhases);
+  for (std::size_t p = 0; p < kPhases; ++p) {
+    expected[p].resize(size(p));
+    for (std::size_t i = 0; i < size(p); ++i) {
+      long before = 0;
+      if (p > 0)
+        for (std::size_t k = 0; k < 3; ++k)
+          before += expected[p - 1][(i * 7 + k) % expected[p - 1].size()];
+      expected[p][i] = before % 1000003 + 1;
+    }
+  }
+  for (unsigned threads : {1u, 2u, 3u}) {
+    WorkerPool pool(threads);
+    for (int round = 0; round < 50; ++round) {
+      std::vector<std::vector<long>> got(kPhases);
+      for (std::size_t p = 0; p < kPhases; ++p) got[p].assign(size(p), 0);
+      pool.for_each_phase(kPhases, 2, size, [&](std::size_t p, std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+          long before = 0;
+          if (p > 0)
+            for (std::size_t k = 0; k < 3; ++k) before += got[p - 1][(i * 7 + k) % got[p - 1].size()];
+          got[p][i] += before % 1000003 + 1;  // += : an index run twice would show
+          for (volatile int spin = 0; spin < 300; spin = spin + 1) {
+          }  // ~0.3 µs per index: phases long enough for a thread to run ahead if it could
+        }
+      });
+      ASSERT_EQ(got, expected) << threads << " threads, round " << round;
+    }
+  }
+}
+
 // The pile: 1,000 boxes falling into one another (broad phase, narrow phase, big islands
 // whose contacts are solved colour by colour).
 TEST(Threads, PileIsBitIdenticalOnOneTwoAndThreeThreads) {
