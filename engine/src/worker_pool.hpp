@@ -47,14 +47,23 @@ class WorkerPool {
   /// thread only once every chunk of the one before is done. One job for all the phases: a
   /// thread waits between phases on a counter (a fraction of a microsecond) where a job per
   /// phase cost the caller a publication, a close and a thread's idle chunk each. `size` is
-  /// called once per phase, on the caller. Allocates only when `phases` grows.
+  /// called once per phase, on the caller. Runs inline when the pool has no workers or the
+  /// phases average under two chunks. Allocates only when `phases` grows.
   template <typename Size, typename Fn>
   void for_each_phase(std::size_t phases, std::size_t grain, Size&& size, Fn&& fn) {
     if (workers_.empty()) {
       for (std::size_t p = 0; p < phases; ++p) fn(p, std::size_t{0}, static_cast<std::size_t>(size(p)));
       return;
     }
-    plan_phases(phases, grain, [&](std::size_t p) { return static_cast<std::size_t>(size(p)); });
+    const std::size_t chunks =
+        plan_phases(phases, grain, [&](std::size_t p) { return static_cast<std::size_t>(size(p)); });
+    // A phase of one chunk has nothing to share and its wait hands the bodies' velocities
+    // between cores: when the phases average under two chunks (`tower`'s chain of contacts,
+    // `pyramid`'s ~10 per colour) the caller runs them all, in the same order.
+    if (chunks < 2 * phases) {
+      for (std::size_t p = 0; p < phases; ++p) fn(p, std::size_t{0}, phases_[p].n);
+      return;
+    }
     run_phases(&call_phase<Fn>, &fn);
   }
 
@@ -70,14 +79,16 @@ class WorkerPool {
   static void call_phase(void* fn, std::size_t phase, std::size_t begin, std::size_t end) {
     (*static_cast<Fn*>(fn))(phase, begin, end);
   }
+  /// Sizes and chunks the phases; returns their chunks in all.
   template <typename Size>
-  void plan_phases(std::size_t phases, std::size_t grain, Size&& size) {
+  std::size_t plan_phases(std::size_t phases, std::size_t grain, Size&& size) {
     if (phase_capacity_ < phases) {
       phase_capacity_ = std::max(phases, 2 * phase_capacity_);
       phases_ = std::make_unique<Phase[]>(phase_capacity_);
     }
     phase_count_ = phases;
     const std::size_t most = 4 * static_cast<std::size_t>(this->size());
+    std::size_t chunks = 0;
     for (std::size_t p = 0; p < phases; ++p) {
       Phase& ph = phases_[p];
       ph.n = size(p);
@@ -85,7 +96,9 @@ class WorkerPool {
       ph.chunks = (ph.n + ph.chunk - 1) / ph.chunk;
       ph.next.store(0, std::memory_order_relaxed);
       ph.done.store(0, std::memory_order_relaxed);
+      chunks += ph.chunks;
     }
+    return chunks;
   }
   void run_phases(PhaseThunk thunk, void* fn);
   void work_phases();

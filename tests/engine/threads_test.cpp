@@ -2,6 +2,8 @@
 // exactly once, and a World steps bit for bit the same on one thread as on several.
 #include <atomic>
 #include <cstring>
+#include <numeric>
+#include <thread>
 #include <vector>
 
 #include "../sanitized.hpp"
@@ -93,13 +95,33 @@ TEST(Threads, PhasesRunInTurnAndEveryIndexOnce) {
           if (p > 0)
             for (std::size_t k = 0; k < 3; ++k) before += got[p - 1][(i * 7 + k) % got[p - 1].size()];
           got[p][i] += before % 1000003 + 1;  // += : an index run twice would show
-          for (volatile int spin = 0; spin < 300; spin = spin + 1) {
-          }  // ~0.3 µs per index: phases long enough for a thread to run ahead if it could
+          [[maybe_unused]] volatile int spin = 0;  // ~0.3 µs per index: long enough phases
+          for (int k = 0; k < 300; ++k) spin = k;
         }
       });
       ASSERT_EQ(got, expected) << threads << " threads, round " << round;
     }
   }
+}
+
+// Phases of a chunk or so each (a tower's chain of contacts) have nothing to share: the
+// caller runs them all, in turn, and no worker is woken for them.
+TEST(Threads, PhasesOfOneChunkRunOnTheCaller) {
+  WorkerPool pool(3);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::vector<std::size_t> order;
+  bool elsewhere = false;
+  auto size = [](std::size_t p) { return p % 3 == 0 ? std::size_t{9} : std::size_t{4}; };  // grain 8
+  pool.for_each_phase(300, 8, size, [&](std::size_t p, std::size_t begin, std::size_t end) {
+    elsewhere = elsewhere || std::this_thread::get_id() != caller;
+    EXPECT_EQ(begin, 0u);
+    EXPECT_EQ(end, size(p));
+    order.push_back(p);
+  });
+  EXPECT_FALSE(elsewhere);
+  std::vector<std::size_t> expected(300);
+  std::iota(expected.begin(), expected.end(), std::size_t{0});
+  EXPECT_EQ(order, expected);
 }
 
 // The pile: 1,000 boxes falling into one another (broad phase, narrow phase, big islands
