@@ -340,6 +340,61 @@ void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, dou
   }
 }
 
+/// Vertical speed (m/s) below which a face vertex counts as still: over a step of 1/60 s it
+/// moves 1.7e-14 m, round-off of the positions themselves.
+constexpr double kStillSpeed = 1e-12;
+
+/// Whether the body lies still on one face of a frictionless floor over the next h seconds:
+/// that face's four vertices touch (within kContactBand) without a vertical velocity, and the
+/// other four are above the band and stay above the floor. The floor's impulse then only
+/// cancels gravity's vertical impulse, at the four corners of the face around the centre of
+/// mass: no torque and no friction, so the body glides and spins freely (v_y = 0, L and the
+/// horizontal momentum as in flight), and contact_step needs no impulse solve. This is what
+/// the solve would find (to round-off): four still vertices fix v_y and the two horizontal
+/// components of ω. A separated fall onto a frictionless floor ends with most boxes so,
+/// spinning about the vertical (1,169 of 2,000 cubes after 2 s).
+bool glides_on_face(const BodyState& s, const BodyConstants& c, const Vec3& gravity,
+                    double floor_y, double h) {
+  if (c.friction != 0.0 || gravity.y() > 0.0) return false;
+  if (std::abs(c.inv_mass * s.P.y()) > 1e-9) return false;  // not still: no need to look
+  const Kinematics k = kinematics_of(s, c);
+  const HalfEdges e(s, c);
+  unsigned touching = 0;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 r = e.vertex(i);
+    const double gap = s.x.y() + r.y() - floor_y;
+    const double vn = k.point_velocity(r).y();
+    if (gap <= kContactBand) {
+      if (std::abs(vn) > kStillSpeed) return false;
+      touching |= 1u << i;
+    } else if (gap + h * std::min(vn + h * gravity.y(), 0.0) < 0.0) {
+      return false;  // a vertex above reaches the floor within the step
+    }
+  }
+  // The four vertices of one face share one sign of ±a, ±b or ±c (HalfEdges' numbering).
+  for (unsigned face : {0x55u, 0xAAu, 0x33u, 0xCCu, 0x0Fu, 0xF0u})
+    if (touching == face) return true;
+  return false;
+}
+
+/// contact_step for a body that glides_on_face: its flight with the vertical momentum held at
+/// zero (the turn from `spin` when it holds it, as in flight). Round-off in the turn that
+/// leaves a vertex below the floor is projected back.
+void glide_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
+                double h, SpinCache* spin) {
+  s.P += (h * c.mass) * gravity;
+  s.P.y() = 0.0;  // the floor's impulse cancels gravity's
+  s.x += h * c.inv_mass * s.P;
+  if (!s.L.isZero()) {
+    // A cube's ω = L / I, as in flight: the same bits step after step, so `spin` holds its turn.
+    const Vec3 angle = c.shape == InertiaShape::isotropic ? Vec3((h * c.inv_inertia.x()) * s.L)
+                                                          : Vec3(h * angular_velocity(s, c));
+    s.R = (spin ? cached_turn(angle, *spin) : rotation_from_vector(angle)) * s.R;
+  }
+  const double lowest = lowest_vertex_y(s, c);
+  if (lowest < floor_y) s.x.y() += floor_y - lowest;
+}
+
 /// Earliest time in [0, h] at which a vertex of `mask` reaches the floor (it is above at 0
 /// and some vertex of the mask is below at h). Returns the non-penetrating end of the final
 /// bracket, so a body is never left inside the floor.
@@ -410,7 +465,8 @@ namespace {
 
 /// advance_with_floor for a body that may meet the floor within the step; `flown`, when not
 /// null, is the state after the whole step's flight from s (already computed by the caller).
-FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyState* flown) {
+FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyState* flown,
+                           SpinCache* spin) {
   FloorStepResult result;
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
@@ -422,7 +478,10 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     // lowest point is at an end while gravity points down).
     const bool start_clear = clear_of_floor(s, c, floor_y);
     if (!start_clear && in_resting_contact(s, c, floor_y, vrest, w.dt)) {
-      contact_step(s, c, w.gravity, floor_y, remaining);
+      if (glides_on_face(s, c, w.gravity, floor_y, remaining))
+        glide_step(s, c, w.gravity, floor_y, remaining, spin);
+      else
+        contact_step(s, c, w.gravity, floor_y, remaining);
       result.touched = true;
       return result;
     }
@@ -472,9 +531,9 @@ FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, Spi
     return {};
   }
   const double floor_y = w.floor->height;
-  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr);
+  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin);
   const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin);
-  if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next);
+  if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next, spin);
   s = next;
   return {};
 }

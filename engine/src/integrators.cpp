@@ -68,17 +68,6 @@ BodyState symplectic_euler(const BodyState& s, const BodyConstants& c, const Vec
   return r;
 }
 
-/// A cube's turn by `angle`, from `spin` when it holds that angle bit for bit (±0 differ:
-/// the turn's zero entries keep their signs, so a copied World without the cache agrees).
-const Mat3& cube_turn(const Vec3& angle, SpinCache& spin) {
-  if (!spin.held || std::memcmp(angle.data(), spin.angle.data(), sizeof(double) * 3) != 0) {
-    spin.turn = rotation_from_vector(angle);
-    spin.angle = angle;
-    spin.held = true;
-  }
-  return spin.turn;
-}
-
 /// The torque-free rotation over h of the `exact` and `splitting` integrators.
 Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants& c, double h,
                  SpinCache* spin) {
@@ -86,7 +75,7 @@ Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants&
   // A cube: ω = L / I is constant, the flow is one rotation (exact for both methods).
   if (c.shape == InertiaShape::isotropic) {
     const Vec3 angle = (h * c.inv_inertia.x()) * s.L;
-    if (spin) return cube_turn(angle, *spin) * s.R;
+    if (spin) return cached_turn(angle, *spin) * s.R;
     return rotation_from_vector(angle) * s.R;
   }
   if (integrator == Integrator::exact) return free_rotation_exact(c.inertia, s.R, s.L, h);
@@ -108,6 +97,17 @@ Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants&
 }
 
 }  // namespace
+
+// Holding the angle bit for bit matters: ±0 differ, and the turn's zero entries keep their
+// signs, so a copied World without the cache agrees.
+const Mat3& cached_turn(const Vec3& angle, SpinCache& spin) {
+  if (!spin.held || std::memcmp(angle.data(), spin.angle.data(), sizeof(double) * 3) != 0) {
+    spin.turn = rotation_from_vector(angle);
+    spin.angle = angle;
+    spin.held = true;
+  }
+  return spin.turn;
+}
 
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
                   const Vec3& gravity, double h, SpinCache* spin) {

@@ -27,6 +27,11 @@ struct SpinCache {
   bool held = false;             ///< Whether it holds a turn yet.
 };
 
+/// rotation_from_vector(angle), from `spin` when it holds that angle bit for bit (then the
+/// same bits without the work); otherwise computed and kept in `spin`. Not thread-safe on
+/// one spin.
+const Mat3& cached_turn(const Vec3& angle, SpinCache& spin);
+
 /// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null).
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
                   const Vec3& gravity, double h, SpinCache* spin = nullptr);

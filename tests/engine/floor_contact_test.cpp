@@ -182,5 +182,37 @@ TEST(Friction, FlatSlideStopsExactlyAtAnyStep) {
   }
 }
 
+// A box lying on a face of a frictionless floor feels gravity and the floor's equal and
+// opposite push, nothing else: it glides in a straight line at its speed and spins about the
+// vertical at its rate, its height unchanged, whatever its shape (floor_contact.cpp,
+// glides_on_face). Over 2 s every figure is exact to round-off.
+TEST(Glide, FaceDownBoxOnFrictionlessFloorGlidesAndSpinsFreely) {
+  for (const Vec3& size : {Vec3(1.0, 1.0, 1.0), Vec3(1.2, 0.4, 0.7)}) {
+    Scene scene;
+    scene.world.floor = Floor{0.0, 0.5, 0.0};
+    scene.world.dt = 1.0 / 240.0;
+    BodyDef b;
+    b.size = size;
+    b.mass = 2.0;
+    b.position = {0.0, 0.5 * size.y(), 0.0};
+    b.velocity = {2.0, 0.0, -1.0};
+    b.angular_velocity = {0.0, 3.0, 0.0};
+    scene.bodies.push_back(b);
+    World world(scene);
+    const Vec3 L0 = world.body(0).s.L;
+    for (int i = 0; i < 480; ++i) world.step();
+    const double t = world.time();
+    const BodyState& s = world.body(0).s;
+    EXPECT_NEAR(s.x.x(), 2.0 * t, 1e-12) << size.transpose();
+    EXPECT_NEAR(s.x.z(), -1.0 * t, 1e-12) << size.transpose();
+    EXPECT_NEAR(s.x.y(), 0.5 * size.y(), 1e-15) << size.transpose();
+    EXPECT_LT((s.P - Vec3(4.0, 0.0, -2.0)).norm(), 1e-12) << size.transpose();
+    EXPECT_LT((s.L - L0).norm(), 1e-12) << size.transpose();
+    const Mat3 turned = Eigen::AngleAxisd(3.0 * t, Vec3::UnitY()).toRotationMatrix();
+    EXPECT_LT(rotation_angle_between(turned, s.R), 1e-12) << size.transpose();
+    EXPECT_EQ(world.body(0).activity, Activity::awake);
+  }
+}
+
 }  // namespace
 }  // namespace tumble
