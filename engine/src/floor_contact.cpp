@@ -357,13 +357,17 @@ bool glides_on_face(const BodyState& s, const BodyConstants& c, const Vec3& grav
                     double floor_y, double h) {
   if (c.friction != 0.0 || gravity.y() > 0.0) return false;
   if (std::abs(c.inv_mass * s.P.y()) > 1e-9) return false;  // not still: no need to look
-  const Kinematics k = kinematics_of(s, c);
+  const Vec3 v = c.inv_mass * s.P;
+  const Vec3 w = angular_velocity(s, c);
+  // A vertex above the band sinks at most this fast (m/s) over the step.
+  const double sink = std::max(-(v.y() + h * gravity.y()), 0.0) + w.norm() * c.bounding_radius;
   const HalfEdges e(s, c);
   unsigned touching = 0;
   for (int i = 0; i < 8; ++i) {
+    const double gap = s.x.y() + e.vertex_y(i) - floor_y;
+    if (gap > kContactBand && gap - h * sink >= 0.0) continue;  // stays above the floor
     const Vec3 r = e.vertex(i);
-    const double gap = s.x.y() + r.y() - floor_y;
-    const double vn = k.point_velocity(r).y();
+    const double vn = v.y() + w.z() * r.x() - w.x() * r.z();  // (v + ω × r)_y
     if (gap <= kContactBand) {
       if (std::abs(vn) > kStillSpeed) return false;
       touching |= 1u << i;
@@ -477,16 +481,21 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     // Bounding sphere clear of the floor at both ends: no vertex test (the flight path's
     // lowest point is at an end while gravity points down).
     const bool start_clear = clear_of_floor(s, c, floor_y);
-    if (!start_clear && in_resting_contact(s, c, floor_y, vrest, w.dt)) {
-      if (glides_on_face(s, c, w.gravity, floor_y, remaining))
-        glide_step(s, c, w.gravity, floor_y, remaining, spin);
-      else
-        contact_step(s, c, w.gravity, floor_y, remaining);
+    // A gliding body is in resting contact too (four vertices touch, still).
+    if (!start_clear && glides_on_face(s, c, w.gravity, floor_y, remaining)) {
+      glide_step(s, c, w.gravity, floor_y, remaining, spin);
       result.touched = true;
       return result;
     }
-    const BodyState next =
-        k == 0 && flown ? *flown : advance(w.integrator, s, c, w.gravity, remaining);
+    if (!start_clear && in_resting_contact(s, c, floor_y, vrest, w.dt)) {
+      contact_step(s, c, w.gravity, floor_y, remaining);
+      result.touched = true;
+      return result;
+    }
+    // The whole step's flight takes a cube's turn from its spin cache, as in flight.
+    const BodyState next = k == 0 && flown ? *flown
+                           : k == 0        ? advance(w.integrator, s, c, w.gravity, remaining, spin)
+                                           : advance(w.integrator, s, c, w.gravity, remaining);
     if (clear_of_floor(next, c, floor_y) && (start_clear || w.gravity.y() <= 0.0)) {
       s = next;
       return result;
