@@ -130,25 +130,32 @@ void collide_pairs(StepContext& ctx) {
 // be driven down faster than it moves now: its floor margin also covers the speed of the
 // fastest body touching it. Every linked body's floor contact is found on its own (shared
 // among the pool's threads), and those that reach the floor are copied, in ascending body
-// order, ahead of the box–box contacts.
+// order, ahead of the box–box contacts. Each linked body's speed bound is found once, on the
+// pool: found contact by contact on the caller they were 2 % of `pile`'s instructions, all
+// of them on one thread.
 void collide_floor(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
   std::uint32_t floor_count = 0;
   if (ctx.world.floor && !s.box_contacts.empty()) {
+    s.speed.resize(ctx.bodies.size());
     s.reach.resize(ctx.bodies.size());
-    for (std::uint32_t id : s.linked) s.reach[id] = 0.0;
+    ctx.pool.for_each(s.linked.size(), 256, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t k = begin; k < end; ++k) {
+        const Body& b = ctx.bodies[s.linked[k]];
+        s.speed[s.linked[k]] = point_speed_bound(b.s, b.c);
+        s.reach[s.linked[k]] = 0.0;
+      }
+    });
     for (const Contact& c : s.box_contacts) {
-      const Body &a = ctx.bodies[c.a], &b = ctx.bodies[c.b];
-      s.reach[c.a] = std::max(s.reach[c.a], point_speed_bound(b.s, b.c));
-      s.reach[c.b] = std::max(s.reach[c.b], point_speed_bound(a.s, a.c));
+      s.reach[c.a] = std::max(s.reach[c.a], s.speed[c.b]);
+      s.reach[c.b] = std::max(s.reach[c.b], s.speed[c.a]);
     }
     s.floor_slots.resize(s.linked.size());
     ctx.pool.for_each(s.linked.size(), 64, [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         const std::uint32_t id = s.linked[k];
         const Body& b = ctx.bodies[id];
-        const double margin =
-            kSpeculativeDistance + ctx.dt * (point_speed_bound(b.s, b.c) + s.reach[id]);
+        const double margin = kSpeculativeDistance + ctx.dt * (s.speed[id] + s.reach[id]);
         floor_contact(b.s, b.c, id, ctx.world.floor->height, margin, s.floor_slots[k]);
       }
     });

@@ -87,6 +87,7 @@ struct StepScratch {
   std::vector<std::int32_t> slot;       ///< Position of each pair's (body's) contact, or −1.
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
+  std::vector<double> speed;            ///< Point-speed bound of each linked body, m/s.
   std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
   int woken = 0;                        ///< Sleeping bodies the narrow phase woke.
   IslandScratch island;                 ///< Union–find and island lists.
