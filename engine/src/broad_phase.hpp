@@ -25,6 +25,15 @@ struct Aabb {
 Aabb swept_aabb(const BodyState& s, const BodyConstants& c, const Vec3& gravity, double dt,
                 double margin);
 
+/// A bound under which a body's swept box stays inside its fat box, checked in a few
+/// instructions instead of computing the box: while x lies in `core`, |P|² ≤ p2 and |L|² ≤ l2
+/// (p2 < 0: no bound, compute the box).
+struct QuietBound {
+  Aabb core;         ///< Where the centre of mass may be, m.
+  double p2 = -1.0;  ///< Largest |P|², (kg·m/s)².
+  double l2 = -1.0;  ///< Largest |L|², (kg·m²/s)².
+};
+
 /// Whether two boxes overlap (touching counts).
 inline bool overlaps(const Aabb& a, const Aabb& b) {
   return a.lo.x() <= b.hi.x() && a.lo.y() <= b.hi.y() && a.lo.z() <= b.hi.z() &&

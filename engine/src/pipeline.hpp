@@ -67,6 +67,11 @@ struct BroadPhaseCache {
   std::vector<std::uint8_t> escaped;     ///< Awake body left its fat box this step.
   std::size_t swept_pairs = 0;           ///< fat_pairs' size after the last sweep.
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
+  std::vector<QuietBound> quiet;         ///< When an unpaired body is still inside its fat box.
+  std::vector<std::uint8_t> stale;       ///< boxes[i] not recomputed this step (quiet body).
+  std::vector<std::uint8_t> paired;      ///< Scratch: body is in fat_pairs.
+  double quiet_dt = 0.0;                 ///< Step the quiet bounds were found for, s.
+  Vec3 quiet_gravity = Vec3::Zero();     ///< Gravity they were found for, m/s².
 };
 
 /// A body's velocities, m/s and rad/s.
