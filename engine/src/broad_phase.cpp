@@ -61,7 +61,7 @@ bool update_box(StepContext& ctx, std::uint32_t i) {
 // cubes re-swept every 8 steps, ~90 instructions per body-step of a flight step of ~1,000.
 // Measured (callgrind) against 16 steps: the first 0.5 s of 10,000 falling cubes 594 -> 549
 // instructions per body-step, 2,000 cubes over 2 s 1 % fewer, `pile` 0.2 % fewer; 64 steps
-// cost the 2 s fall 3.5 % more (a landed box's fat box reaches far below the floor).
+// cost the 2 s fall 3.5 % more.
 constexpr double kFatSteps = 32.0;
 
 /// Lowest and highest value of d(t) = v t + ½ g t² over t ∈ [0, T].
