@@ -104,7 +104,8 @@ Aabb fat_box(const Aabb& tight, const Body& b, const Vec3& gravity, double dt) {
 // the pairs are those of the box computed: a fall of 10,000 cubes skips 93 % of the boxes.
 
 // How long a quiet bound lets a body fall, in steps: past its kFatSteps the fat box still
-// holds a falling body for a dozen steps more (its margin).
+// holds a falling body for some steps more (its margin), and with a bound of kFatSteps a
+// fall of 10,000 cubes computed a third of its boxes for nothing.
 constexpr double kQuietSteps = 2.0 * kFatSteps;
 
 /// The quiet bound of body b whose fat box was just built (none when b's box is too wide
