@@ -9,29 +9,43 @@ std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
   return (static_cast<std::uint64_t>(a) << 32) | b;
 }
 
-/// Starts each contact from the impulses its pair had last step (matched by key).
+/// Starts each contact from the impulses its pair had last step (matched by key); each
+/// contact on its own, shared among the pool's threads.
 void warm_start(StepContext& ctx) {
   const ContactCache& cache = ctx.cache;
-  for (Contact& c : ctx.scratch.contacts) {
-    const std::uint64_t key = pair_key(c.a, c.b);
-    const auto it = std::lower_bound(
-        cache.previous_keys.begin(), cache.previous_keys.end(), key,
-        [](const std::pair<std::uint64_t, std::uint32_t>& e, std::uint64_t k) { return e.first < k; });
-    if (it != cache.previous_keys.end() && it->first == key)
-      warm_start_from(c, cache.previous[it->second]);
-  }
+  std::span<Contact> contacts = ctx.scratch.contacts;
+  ctx.pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      Contact& c = contacts[i];
+      const std::uint64_t key = pair_key(c.a, c.b);
+      const auto it = std::lower_bound(
+          cache.previous_keys.begin(), cache.previous_keys.end(), key,
+          [](const std::pair<std::uint64_t, std::uint32_t>& e, std::uint64_t k) { return e.first < k; });
+      if (it != cache.previous_keys.end() && it->first == key)
+        warm_start_from(c, cache.previous[it->second]);
+    }
+  });
 }
 
-/// Keeps this step's contacts (with their impulses) for the next step's warm start.
+/// Keeps this step's contacts (with their impulses) for the next step's warm start. The
+/// narrow phase lists the floor's contacts (body a = kStaticBody, the largest key) in body
+/// order and then the box–box ones in pair order: two sorted runs, put in order by a rotation
+/// (a sort of the keys was 1 % of `pile`, on one thread); a sort if ever they are not.
 void keep_for_warm_start(StepContext& ctx) {
   ContactCache& cache = ctx.cache;
   std::swap(cache.previous, ctx.scratch.contacts);
   ctx.scratch.contacts.clear();
-  cache.previous_keys.clear();
+  auto& keys = cache.previous_keys;
+  keys.clear();
   for (std::size_t i = 0; i < cache.previous.size(); ++i)
-    cache.previous_keys.emplace_back(pair_key(cache.previous[i].a, cache.previous[i].b),
-                                     static_cast<std::uint32_t>(i));
-  std::sort(cache.previous_keys.begin(), cache.previous_keys.end());
+    keys.emplace_back(pair_key(cache.previous[i].a, cache.previous[i].b),
+                      static_cast<std::uint32_t>(i));
+  const auto mid = std::is_sorted_until(keys.begin(), keys.end());
+  if (mid == keys.end()) return;
+  if (std::is_sorted(mid, keys.end()) && keys.back() < keys.front())
+    std::rotate(keys.begin(), mid, keys.end());
+  else
+    std::sort(keys.begin(), keys.end());
 }
 
 }  // namespace

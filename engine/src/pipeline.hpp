@@ -91,6 +91,7 @@ struct StepScratch {
   std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
   std::vector<std::int32_t> slot;       ///< Position of each pair's (body's) contact, or −1.
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
+  std::vector<std::uint8_t> marked;     ///< Scratch of `linked`: body is in a box–box contact.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
   std::vector<double> speed;            ///< Point-speed bound of each linked body, m/s.
   std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
