@@ -131,9 +131,7 @@ QuietBound quiet_bound(const Aabb& fat, const Body& b, const Vec3& gravity, doub
 
 /// Whether a body in state s is still within its quiet bound q (false when q is none).
 bool within(const QuietBound& q, const BodyState& s) {
-  return s.P.squaredNorm() <= q.p2 && s.L.squaredNorm() <= q.l2 && q.core.lo.x() <= s.x.x() &&
-         q.core.lo.y() <= s.x.y() && q.core.lo.z() <= s.x.z() && s.x.x() <= q.core.hi.x() &&
-         s.x.y() <= q.core.hi.y() && s.x.z() <= q.core.hi.z();
+  return s.P.squaredNorm() <= q.p2 && s.L.squaredNorm() <= q.l2 && contains(q.core, {s.x, s.x});
 }
 
 /// Body i's box brought up to date if a quiet step skipped it, and its quiet bound dropped
