@@ -34,10 +34,19 @@
 
 namespace tumble {
 
+/// Where a body was when its still time began (sleep.cpp), in float: the sleep rule compares
+/// displacements of millimetres, far above float's rounding of a position.
+struct SleepAnchor {
+  Eigen::Vector3f x = Eigen::Vector3f::Zero();  ///< Centre of mass, world, m.
+  Eigen::Matrix3f R = Eigen::Matrix3f::Zero();  ///< Orientation (body → world).
+};
+
 /// What persists between steps and decides results: copied with the World.
 struct ContactCache {
   /// Ring of each sleeping island: sleep_next[i] is the next member (i itself when alone).
   std::vector<std::uint32_t> sleep_next;
+  /// Per body, its pose when its still time began.
+  std::vector<SleepAnchor> anchors;
   /// Last step's contacts, for warm starting.
   std::vector<Contact> previous;
   /// (pair key, index into previous), sorted by key.
@@ -118,7 +127,8 @@ struct StepContext {
   WorkerPool& pool;          ///< Threads for the stages' independent work (1: inline).
 };
 
-/// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island).
+/// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island); called
+/// again with a larger count when a body is added.
 void init_caches(ContactCache& cache, std::size_t body_count);
 
 /// Stage: swept boxes of the candidates and the pairs whose boxes overlap (scratch.pairs).

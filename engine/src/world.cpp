@@ -131,7 +131,7 @@ BodyId World::add_body(const BodyDef& def) {
   const auto id = static_cast<BodyId>(bodies_.size());
   bodies_.push_back(b);
   scene_.bodies.push_back(def);
-  cache_->sleep_next.push_back(id);  // an island of its own
+  init_caches(*cache_, bodies_.size());  // an island of its own
   ++cache_->activity_epoch;          // the broad phase sees a new body: it rescans
   return id;
 }
