@@ -3,6 +3,7 @@
 /// Pure functions; thread-safe.
 #include <cstdint>
 
+#include "free_rotation.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
 
@@ -32,8 +33,10 @@ struct SpinCache {
 /// one spin.
 const Mat3& cached_turn(const Vec3& angle, SpinCache& spin);
 
-/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null).
+/// `advance` with a cube's turn taken from `spin` when it holds this step's, and a general
+/// box's constants of motion from `memo` under `exact` (free_rotation.hpp); either may be null.
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin = nullptr);
+                  const Vec3& gravity, double h, SpinCache* spin = nullptr,
+                  PolhodeMemo* memo = nullptr);
 
 }  // namespace tumble
