@@ -39,9 +39,13 @@ double moved_from(const SleepAnchor& a, const BodyState& s, const BodyConstants&
 // momentarily on an edge (two corners) still waits for the timer.
 void update_still_time(Body& b, SleepAnchor& anchor, double dt, const WorldDef& world) {
   if (b.activity != Activity::awake) return;
+  if (!b.in_contact) {  // in flight: nothing to keep (the anchor is not touched)
+    b.still_time = 0.0;
+    return;
+  }
   if (b.still_time == 0.0) anchor = anchor_of(b.s);
-  const bool still = b.in_contact && (point_speed_bound(b.s, b.c) <= kSleepSpeed ||
-                                      moved_from(anchor, b.s, b.c) <= kSleepReach);
+  const bool still = point_speed_bound(b.s, b.c) <= kSleepSpeed ||
+                     moved_from(anchor, b.s, b.c) <= kSleepReach;
   b.still_time = still ? b.still_time + dt : 0.0;
   if (still && world.floor && at_rest_on_face(b.s, b.c, world.floor->height))
     b.still_time = std::max(b.still_time, kSleepTime);

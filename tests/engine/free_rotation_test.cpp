@@ -58,6 +58,18 @@ struct TumbleCase {
   Vec3 L = inertia.cwiseProduct(Vec3(0.01, 2.0, 0.01));
 };
 
+// The tumble case's 600 frames of 1/30 s.
+constexpr int kTumbleSteps = 600;
+constexpr double kTumbleDt = 1.0 / 30.0;
+
+// The reference attitude at every frame (Bulirsch–Stoer on the matrix form) and the times.
+std::vector<Mat3> tumble_frames(const TumbleCase& c, std::vector<double>& times) {
+  times.clear();
+  for (int i = 1; i <= kTumbleSteps; ++i) times.push_back(i * kTumbleDt);
+  return tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                     Method::kMatrixBulirschStoer);
+}
+
 TEST(FreeRotationExact, CubeMatchesClosedForm) {
   const Vec3 inertia = box_inertia({1.0, 1.0, 1.0}, 2.0);  // I = 1/3 kg·m² on every axis
   const Mat3 R0 = some_rotation(0.3, -1.1, 2.0);
@@ -122,12 +134,10 @@ TEST(FreeRotationExact, TumbleCaseMatchesReference) {
   EXPECT_LT(distance, 4.0e-6);
 
   // Reference at every 1/30 s frame.
-  const int steps = 600;
-  const double dt = 1.0 / 30.0;
+  const int steps = kTumbleSteps;
+  const double dt = kTumbleDt;
   std::vector<double> times;
-  for (int i = 1; i <= steps; ++i) times.push_back(i * dt);
-  const auto ref = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
-                                                               Method::kMatrixBulirschStoer);
+  const auto ref = tumble_frames(c, times);
 
   const Mat3 one_shot = free_rotation_exact(c.inertia, c.R0, c.L, 20.0);
   const double one_shot_error = rotation_angle_between(ref.back(), one_shot);
@@ -375,12 +385,10 @@ TEST(FreeRotationSplitting, TumbleCaseAccuracyAndInvariants) {
 // step is then bit for bit the memo-less one, and a poisoned memo shows which was used.
 TEST(FreeRotationExact, MemoKeepsTheFlowToRoundOffAndOnlyServesTheStateItEnded) {
   const TumbleCase c;
-  const int steps = 600;
-  const double dt = 1.0 / 30.0;
+  const int steps = kTumbleSteps;
+  const double dt = kTumbleDt;
   std::vector<double> times;
-  for (int i = 1; i <= steps; ++i) times.push_back(i * dt);
-  const auto ref = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
-                                                               Method::kMatrixBulirschStoer);
+  const auto ref = tumble_frames(c, times);
   PolhodeMemo memo;
   Mat3 with = c.R0, without = c.R0;
   double worst = 0.0, apart = 0.0;
