@@ -43,16 +43,12 @@ void flight(StepContext& ctx) {
   // slot that changes body is recomputed: the cache is keyed by the turn's angle alone), so
   // the memory follows the bodies in flight, 104 bytes each, not the world's size.
   if (s.spins.size() < s.lone_bodies.size()) s.spins.resize(s.lone_bodies.size());
-  // A general box's memo is the body's own and persists: its values decide results.
-  PolhodeMemo* polhodes = ctx.cache.polhodes.empty() ? nullptr : ctx.cache.polhodes.data();
   ctx.pool.for_each(s.lone_bodies.size(), kLoneGrain, [&](std::size_t begin, std::size_t end) {
     std::uint32_t impacts = 0, iterations = 0;
     for (std::size_t k = begin; k < end; ++k) {
-      const std::uint32_t i = s.lone_bodies[k];
-      Body& b = ctx.bodies[i];
+      Body& b = ctx.bodies[s.lone_bodies[k]];
       before[k] = b.s;
-      const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt, &s.spins[k],
-                                                   polhodes ? polhodes + i : nullptr);
+      const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt, &s.spins[k]);
       impacts += static_cast<std::uint32_t>(r.impacts);
       iterations += static_cast<std::uint32_t>(r.toi_iterations);
       b.in_contact = r.touched;

@@ -470,7 +470,7 @@ namespace {
 /// advance_with_floor for a body that may meet the floor within the step; `flown`, when not
 /// null, is the state after the whole step's flight from s (already computed by the caller).
 FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyState* flown,
-                           SpinCache* spin, PolhodeMemo* memo) {
+                           SpinCache* spin) {
   FloorStepResult result;
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
@@ -492,12 +492,10 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
       result.touched = true;
       return result;
     }
-    // The whole step's flight takes a cube's turn from its spin cache and a general box's
-    // constants from its memo, as in flight.
-    const BodyState next =
-        k == 0 && flown ? *flown
-        : k == 0        ? advance(w.integrator, s, c, w.gravity, remaining, spin, memo)
-                        : advance(w.integrator, s, c, w.gravity, remaining);
+    // The whole step's flight takes a cube's turn from its spin cache, as in flight.
+    const BodyState next = k == 0 && flown ? *flown
+                           : k == 0        ? advance(w.integrator, s, c, w.gravity, remaining, spin)
+                                           : advance(w.integrator, s, c, w.gravity, remaining);
     if (clear_of_floor(next, c, floor_y) && (start_clear || w.gravity.y() <= 0.0)) {
       s = next;
       return result;
@@ -534,18 +532,17 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
 // Most steps of most bodies are in flight, clear of the floor: that case is one call of the
 // integrator and two comparisons, kept apart from the contact code (whose stack frame and
 // saved registers were a third of the instructions of a cube's flight).
-FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin,
-                                   PolhodeMemo* memo) {
+FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin) {
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
   if (!w.floor) {
-    s = advance(w.integrator, s, c, w.gravity, dt, spin, memo);
+    s = advance(w.integrator, s, c, w.gravity, dt, spin);
     return {};
   }
   const double floor_y = w.floor->height;
-  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin, memo);
-  const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin, memo);
-  if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next, spin, memo);
+  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin);
+  const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin);
+  if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next, spin);
   s = next;
   return {};
 }

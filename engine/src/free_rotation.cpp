@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <numbers>
 
 #include <boost/math/policies/policy.hpp>
@@ -270,8 +269,7 @@ struct Polhode {
   double sigma1 = 1.0;
   Jacobi start;
 
-  // The constants from the moments and the D_i.
-  Polhode(double J1, double J2, double J3, double D1, double D2, double D3) {
+  Polhode(const Vec3& m0, double J1, double J2, double J3, double D1, double D2, double D3) {
     const double r31 = 1.0 / (J3 - J1), r32 = 1.0 / (J3 - J2), r32d1 = r32 / D1;
     a1 = std::sqrt(J1 * D3 * r31);
     a2 = std::sqrt(J2 * D3 * r32);
@@ -281,13 +279,6 @@ struct Polhode {
     kc2 = std::max(0.0, (J3 - J1) * D2 * r32d1);
     n = -J3 * (J2 - J1) * r32 / J1;
     s = J3 > J2 ? 1.0 : -1.0;
-  }
-  // The constants a memo holds.
-  explicit Polhode(const PolhodeMemo& m)
-      : a1(m.a1), a2(m.a2), a3(m.a3), lambda(m.lambda), k2(m.k2), kc2(m.kc2), n(m.n), s(m.s) {}
-
-  // Reads the start phase off m0.
-  void start_at(const Vec3& m0) {
     sigma1 = kc2 == 0.0 && m0[0] < 0.0 ? -1.0 : 1.0;
     const double x = sigma1 * m0[0] / a1, y = sigma1 * s * m0[1] / a2;
     const double inv_h = 1.0 / std::sqrt(x * x + y * y);  // 1 up to round-off
@@ -302,26 +293,8 @@ struct Polhode {
   }
 };
 
-// What increment_flow needs of the increment τ alone: sn, cn, dn at τ, the R_J term
-// sn³ τ R_J(cn² τ, dn² τ, 1, 1 − n sn² τ) and w = √(−n (k² − n)(1 − n)).
-struct Increment {
-  Jacobi f1;
-  double head = 0.0;
-  double w = 0.0;
-};
-
-Increment increment_of(const Polhode& p, double tau) {
-  Increment inc;
-  inc.f1 = jacobi_near_zero(tau, p.k2);
-  const Jacobi& f1 = inc.f1;
-  inc.head = f1.sn * f1.sn * f1.sn *
-             carlson_rj(f1.cn * f1.cn, f1.dn * f1.dn, 1.0, 1.0 - p.n * f1.sn * f1.sn);
-  inc.w = std::sqrt(-p.n * (p.k2 - p.n) * (1.0 - p.n));
-  return inc;
-}
-
-// One increment τ = λt (|τ| ≤ kMaxIncrement, its terms in `inc`): returns sn, cn, dn at u0 + τ,
-// and in `bracket` the (3/n)[Π(u) − u] from u0 to u0 + τ of the comment above.
+// One increment τ = λt (|τ| ≤ kMaxIncrement): returns sn, cn, dn at u0 + τ, and in `bracket`
+// the (3/n)[Π(u) − u] from u0 to u0 + τ of the comment above.
 // Why: the addition theorem of Π (Whittaker & Watson, Modern Analysis, §22.74, for Jacobi's
 // Π(u, a), moved to Legendre's characteristic n = k² sn² a; checked to 1e-30 against quadrature)
 //   Π(u0) + Π(τ) − Π(u0 + τ) = −(n/w) atan(w X / A),  w = √(−n (k² − n)(1 − n)),
@@ -330,9 +303,9 @@ Increment increment_of(const Polhode& p, double tau) {
 // R_J over [0, τ], whose arguments all lie within ~|n| τ² of 1, instead of two over whole
 // quarter periods; sn, cn at u0 + τ follow from DLMF 22.8.1–2. Both are analytic in u0, so no
 // half periods are counted.
-Jacobi increment_flow(const Polhode& p, const Increment& inc, double& bracket) {
+Jacobi increment_flow(const Polhode& p, double tau, double& bracket) {
   const Jacobi& f0 = p.start;
-  const Jacobi& f1 = inc.f1;
+  const Jacobi f1 = jacobi_near_zero(tau, p.k2);
   const double s01 = f0.sn * f1.sn;
   const double inv = 1.0 / (1.0 - p.k2 * s01 * s01);
   Jacobi f;
@@ -341,12 +314,14 @@ Jacobi increment_flow(const Polhode& p, const Increment& inc, double& bracket) {
   // dn from cn and sn (dn² = cn² + k'² sn²), not the third addition formula: this puts m(t)
   // on the energy surface with M² − 2E J2 exact to relative round-off, as periodic_flow does.
   f.dn = std::sqrt(f.cn * f.cn + p.kc2 * f.sn * f.sn);
+  const double rj = carlson_rj(f1.cn * f1.cn, f1.dn * f1.dn, 1.0, 1.0 - p.n * f1.sn * f1.sn);
   const double X = s01 * f.sn;
   const double A = 1.0 - p.n * (f.sn * f.sn - s01 * f.cn * f.dn);
+  const double w = std::sqrt(-p.n * (p.k2 - p.n) * (1.0 - p.n));
   // atan z = z R_C(1, 1 + z²): z is O(τ) small over a step, where carlson_rc1 is a short
   // series instead of the library's atan.
-  const double z = inc.w * X / A;
-  bracket = inc.head + 3.0 * z * carlson_rc1(z * z) / inc.w;
+  const double z = w * X / A;
+  bracket = f1.sn * f1.sn * f1.sn * rj + 3.0 * z * carlson_rc1(z * z) / w;
   return f;
 }
 
@@ -392,46 +367,18 @@ Jacobi periodic_flow(const Polhode& p, double tau, double& bracket) {
   return f;
 }
 
-// The constants of a flight step that do not depend on the start phase: the polhode's, the
-// increment's, |L| and the coefficient of the Π bracket in ψ.
-struct FlowConstants {
-  Polhode polhode;
-  Increment increment;  // set when |λt| ≤ kMaxIncrement
-  double M = 0.0;
-  double c = 0.0;
-};
-
-FlowConstants flow_constants(const Vec3& m0, double J1, double J2, double J3, double D1,
-                             double D2, double D3, double t) {
-  FlowConstants k{Polhode(J1, J2, J3, D1, D2, D3), {}, m0.norm(), 0.0};
-  const Polhode& p = k.polhode;
-  if (std::abs(p.lambda * t) <= kMaxIncrement) k.increment = increment_of(p, p.lambda * t);
-  k.c = -k.M * (J3 - J1) * (J2 - J1) / (3.0 * p.lambda * J1 * J1 * (J3 - J2));
-  return k;
-}
-
-FlowConstants remembered(const PolhodeMemo& m) {
-  return {Polhode(m), Increment{Jacobi{m.sn, m.cn, m.dn}, m.head, m.w}, m.M, m.c};
-}
-
-void remember(const FlowConstants& k, PolhodeMemo& m) {
-  const Polhode& p = k.polhode;
-  m.a1 = p.a1, m.a2 = p.a2, m.a3 = p.a3, m.lambda = p.lambda;
-  m.k2 = p.k2, m.kc2 = p.kc2, m.n = p.n, m.s = p.s;
-  m.M = k.M, m.c = k.c, m.w = k.increment.w, m.head = k.increment.head;
-  m.sn = k.increment.f1.sn, m.cn = k.increment.f1.cn, m.dn = k.increment.f1.dn;
-}
-
 // The canonical-frame part of general_flow, P(m0)ᵀ Rz(ψ(t)) P(m(t)) for moments J1, J2, J3
-// (axis 3 encircled, m0[2] > 0, m0[0]² + m0[1]² > 0) and the constants k.
-Mat3 elliptic_flow(const Vec3& m0, double J1, FlowConstants& k, double t) {
-  Polhode& p = k.polhode;
-  p.start_at(m0);
+// (axis 3 encircled, m0[2] > 0, m0[0]² + m0[1]² > 0) and D_i as defined there.
+Mat3 elliptic_flow(const Vec3& m0, double J1, double J2, double J3, double D1, double D2,
+                   double D3, double t) {
+  const Polhode p(m0, J1, J2, J3, D1, D2, D3);
   const double tau = p.lambda * t;
   double bracket = 0.0;
-  const Jacobi f = std::abs(tau) <= kMaxIncrement ? increment_flow(p, k.increment, bracket)
+  const Jacobi f = std::abs(tau) <= kMaxIncrement ? increment_flow(p, tau, bracket)
                                                   : periodic_flow(p, tau, bracket);
-  const double psi = k.M * t / J1 + k.c * bracket;
+  const double M = m0.norm();
+  const double c = -M * (J3 - J1) * (J2 - J1) / (3.0 * p.lambda * J1 * J1 * (J3 - J2));
+  const double psi = M * t / J1 + c * bracket;
   // Rz(ψ) P(m(t)) as a rotation of the first two rows, not a 3×3 product.
   Mat3 q = momentum_frame(p.momentum(f));
   double cos_psi, sin_psi;
@@ -442,10 +389,8 @@ Mat3 elliptic_flow(const Vec3& m0, double J1, FlowConstants& k, double t) {
   return momentum_frame(m0).transpose() * q;
 }
 
-// `memo`, when not null, holds this flight's constants if memo->held (the caller checked
-// the state) and gets them otherwise, when the step is an increment; memo->held tells which.
 Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
-                  const std::array<int, 3>& sorted, PolhodeMemo* memo) {
+                  const std::array<int, 3>& sorted) {
   const Vec3 mb = R.transpose() * L;
   const double Ib = inertia[sorted[1]];
   // M² − 2E·I_mid, from the two outer moments only.
@@ -455,8 +400,6 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   const std::array<int, 3> perm =
       d_mid >= 0.0 ? sorted : std::array<int, 3>{sorted[2], sorted[1], sorted[0]};
   const double J1 = inertia[perm[0]], J2 = inertia[perm[1]], J3 = inertia[perm[2]];
-  const bool recalled = memo && memo->held && memo->axes == perm;
-  if (memo) memo->held = false;
   // Steady spin about the middle axis (the unstable equilibrium): a plain rotation.
   if (mb[perm[0]] == 0.0 && mb[perm[2]] == 0.0) {
     return R * axis_rotation(perm[1], t * mb[perm[1]] / J2);
@@ -469,6 +412,8 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
 
   const double q1 = m0[0] * m0[0] / J1, q2 = m0[1] * m0[1] / J2, q3 = m0[2] * m0[2] / J3;
   const double D3 = q1 * (J3 - J1) + q2 * (J3 - J2);  // 2E J3 − M²
+  const double D1 = q2 * (J2 - J1) + q3 * (J3 - J1);  // M² − 2E J1
+  const double D2 = q1 * (J1 - J2) + q3 * (J3 - J2);  // M² − 2E J2
 
   Mat3 frame = Mat3::Zero();  // R0 Cᵀ
   for (int i = 0; i < 3; ++i) frame.col(i) = sgn[i] * R.col(perm[i]);
@@ -477,16 +422,7 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
     // Steady spin about canonical axis 3.
     canonical = frame * rotation_about_z(t * m0[2] / J3);
   } else {
-    const double D1 = q2 * (J2 - J1) + q3 * (J3 - J1);  // M² − 2E J1
-    const double D2 = q1 * (J1 - J2) + q3 * (J3 - J2);  // M² − 2E J2
-    FlowConstants k = recalled ? remembered(*memo)
-                               : flow_constants(m0, J1, J2, J3, D1, D2, D3, t);
-    if (memo && std::abs(k.polhode.lambda * t) <= kMaxIncrement) {
-      if (!recalled) remember(k, *memo);
-      memo->axes = perm;
-      memo->held = true;
-    }
-    canonical = frame * elliptic_flow(m0, J1, k, t);
+    canonical = frame * elliptic_flow(m0, J1, J2, J3, D1, D2, D3, t);
   }
   Mat3 out;
   for (int i = 0; i < 3; ++i) out.col(perm[i]) = sgn[i] * canonical.col(i);
@@ -496,11 +432,6 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
 }  // namespace
 
 Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
-  return free_rotation_exact(inertia, R, L, t, nullptr);
-}
-
-Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
-                         PolhodeMemo* memo) {
   if (L.squaredNorm() == 0.0 || t == 0.0) return R;
   const std::array<int, 3> sorted = axes_by_moment(inertia);
   const double lo = inertia[sorted[0]], mid = inertia[sorted[1]], hi = inertia[sorted[2]];
@@ -518,19 +449,7 @@ Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, doub
     const double theta = t * (1.0 / inertia[k] - 1.0 / i_perp) * mk;
     return rotation_from_vector(t * L / i_perp) * R * axis_rotation(k, theta);
   }
-  if (!memo) return general_flow(inertia, R, L, t, sorted, nullptr);
-  // The memo is this flight's when the step starts where its step ended, bit for bit (±0 and
-  // all): then nothing but the flight itself has moved R or L since.
-  memo->held = memo->held && memo->t == t &&
-               std::memcmp(memo->L.data(), L.data(), sizeof(double) * 3) == 0 &&
-               std::memcmp(memo->R_end.data(), R.data(), sizeof(double) * 9) == 0;
-  const Mat3 out = general_flow(inertia, R, L, t, sorted, memo);
-  if (memo->held) {
-    memo->R_end = out;
-    memo->L = L;
-    memo->t = t;
-  }
-  return out;
+  return general_flow(inertia, R, L, t, sorted);
 }
 
 // Symmetric (Strang) composition of the three exact axis flows (McLachlan 1993; Dullweber,

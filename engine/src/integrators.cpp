@@ -70,7 +70,7 @@ BodyState symplectic_euler(const BodyState& s, const BodyConstants& c, const Vec
 
 /// The torque-free rotation over h of the `exact` and `splitting` integrators.
 Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants& c, double h,
-                 SpinCache* spin, PolhodeMemo* memo) {
+                 SpinCache* spin) {
   if (s.L.isZero()) return s.R;  // No spin: nothing to rotate.
   // A cube: ω = L / I is constant, the flow is one rotation (exact for both methods).
   if (c.shape == InertiaShape::isotropic) {
@@ -78,7 +78,7 @@ Mat3 torque_free(Integrator integrator, const BodyState& s, const BodyConstants&
     if (spin) return cached_turn(angle, *spin) * s.R;
     return rotation_from_vector(angle) * s.R;
   }
-  if (integrator == Integrator::exact) return free_rotation_exact(c.inertia, s.R, s.L, h, memo);
+  if (integrator == Integrator::exact) return free_rotation_exact(c.inertia, s.R, s.L, h);
   return free_rotation_splitting(c.inertia, s.R, s.L, h);
 }
 
@@ -110,14 +110,14 @@ const Mat3& cached_turn(const Vec3& angle, SpinCache& spin) {
 }
 
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin, PolhodeMemo* memo) {
+                  const Vec3& gravity, double h, SpinCache* spin) {
   if (integrator != Integrator::exact && integrator != Integrator::splitting)
     return advance_in_stages(integrator, s, c, gravity, h);
   // Ballistic translation in closed form, x(h) = x + v h + ½ g h², P(h) = P + m g h, and the
   // torque-free rotation; every field written once (no default state built and overwritten:
   // this is the whole step of a body in flight).
   return {s.x + h * (c.inv_mass * s.P) + (0.5 * h * h) * gravity,
-          torque_free(integrator, s, c, h, spin, memo), s.P + (h * c.mass) * gravity, s.L};
+          torque_free(integrator, s, c, h, spin), s.P + (h * c.mass) * gravity, s.L};
 }
 
 }  // namespace tumble

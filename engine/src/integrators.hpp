@@ -3,7 +3,6 @@
 /// Pure functions; thread-safe.
 #include <cstdint>
 
-#include "free_rotation.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
 
@@ -33,10 +32,8 @@ struct SpinCache {
 /// one spin.
 const Mat3& cached_turn(const Vec3& angle, SpinCache& spin);
 
-/// `advance` with a cube's turn taken from `spin` when it holds this step's, and a general
-/// box's constants of motion from `memo` under `exact` (free_rotation.hpp); either may be null.
+/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null).
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin = nullptr,
-                  PolhodeMemo* memo = nullptr);
+                  const Vec3& gravity, double h, SpinCache* spin = nullptr);
 
 }  // namespace tumble

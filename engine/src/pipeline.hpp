@@ -54,9 +54,6 @@ struct ContactCache {
   /// Counts changes of any body's activity (wake, sleep, freeze): caches derived from the
   /// activity flags are valid while it stays put.
   std::uint64_t activity_epoch = 0;
-  /// Per body, the constants of its exact free rotation kept for its next step
-  /// (free_rotation.hpp); empty while no body is a general box, so cubes pay nothing.
-  std::vector<PolhodeMemo> polhodes;
 };
 
 /// Broad-phase acceleration kept between steps. It never changes a result (the pairs come out

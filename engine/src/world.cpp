@@ -1,6 +1,5 @@
 #include "tumble/world.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -56,9 +55,6 @@ World::World(Scene scene) : scene_(std::move(scene)) {
   scratch_ = std::make_unique<StepScratch>();
   pool_ = std::make_unique<WorkerPool>(1);
   init_caches(*cache_, bodies_.size());
-  if (std::any_of(bodies_.begin(), bodies_.end(),
-                  [](const Body& b) { return b.c.shape == InertiaShape::general; }))
-    cache_->polhodes.resize(bodies_.size());
   prime_broad_phase();
 }
 
@@ -136,9 +132,7 @@ BodyId World::add_body(const BodyDef& def) {
   bodies_.push_back(b);
   scene_.bodies.push_back(def);
   init_caches(*cache_, bodies_.size());  // an island of its own
-  if (!cache_->polhodes.empty() || b.c.shape == InertiaShape::general)
-    cache_->polhodes.resize(bodies_.size());
-  ++cache_->activity_epoch;          // the broad phase sees a new body: it rescans
+  ++cache_->activity_epoch;  // the broad phase sees a new body: it rescans
   return id;
 }
 

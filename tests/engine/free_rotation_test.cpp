@@ -7,8 +7,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <tuple>
 #include <string>
 #include <vector>
 
@@ -57,18 +55,6 @@ struct TumbleCase {
   Mat3 R0 = Mat3::Identity();
   Vec3 L = inertia.cwiseProduct(Vec3(0.01, 2.0, 0.01));
 };
-
-// The tumble case's 600 frames of 1/30 s.
-constexpr int kTumbleSteps = 600;
-constexpr double kTumbleDt = 1.0 / 30.0;
-
-// The reference attitude at every frame (Bulirsch–Stoer on the matrix form) and the times.
-std::vector<Mat3> tumble_frames(const TumbleCase& c, std::vector<double>& times) {
-  times.clear();
-  for (int i = 1; i <= kTumbleSteps; ++i) times.push_back(i * kTumbleDt);
-  return tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
-                                                     Method::kMatrixBulirschStoer);
-}
 
 TEST(FreeRotationExact, CubeMatchesClosedForm) {
   const Vec3 inertia = box_inertia({1.0, 1.0, 1.0}, 2.0);  // I = 1/3 kg·m² on every axis
@@ -134,10 +120,12 @@ TEST(FreeRotationExact, TumbleCaseMatchesReference) {
   EXPECT_LT(distance, 4.0e-6);
 
   // Reference at every 1/30 s frame.
-  const int steps = kTumbleSteps;
-  const double dt = kTumbleDt;
+  const int steps = 600;
+  const double dt = 1.0 / 30.0;
   std::vector<double> times;
-  const auto ref = tumble_frames(c, times);
+  for (int i = 1; i <= steps; ++i) times.push_back(i * dt);
+  const auto ref = tumble_reference::free_rigid_body_attitudes(c.inertia, c.R0, c.L, times,
+                                                               Method::kMatrixBulirschStoer);
 
   const Mat3 one_shot = free_rotation_exact(c.inertia, c.R0, c.L, 20.0);
   const double one_shot_error = rotation_angle_between(ref.back(), one_shot);
@@ -373,52 +361,6 @@ TEST(FreeRotationSplitting, TumbleCaseAccuracyAndInvariants) {
   const double e2 = splitting_error(c.inertia, c.R0, c.L, 2.0, 400);
   report("tumble_splitting_ratio_h/h2_over_2s", e1 / e2);
   EXPECT_NEAR(e1 / e2, 4.0, 0.4);
-}
-
-
-// The memo of a general box's constants (PolhodeMemo) serves the step that starts where the
-// last one ended. Over the tumble case's 600 steps (3.5e-6 from the separatrix, where the
-// period is most sensitive to the energy) the composition with the memo stays on the
-// reference as closely as one call over the whole time does (1.8e-13 rad); without it each
-// step re-derives the energy from its rounded state, and the period's drift adds up to
-// 1.9e-10 rad. A memo whose key misses (an edited R, another L or t) is set aside: the
-// step is then bit for bit the memo-less one, and a poisoned memo shows which was used.
-TEST(FreeRotationExact, MemoKeepsTheFlowToRoundOffAndOnlyServesTheStateItEnded) {
-  const TumbleCase c;
-  const int steps = kTumbleSteps;
-  const double dt = kTumbleDt;
-  std::vector<double> times;
-  const auto ref = tumble_frames(c, times);
-  PolhodeMemo memo;
-  Mat3 with = c.R0, without = c.R0;
-  double worst = 0.0, apart = 0.0;
-  for (int i = 0; i < steps; ++i) {
-    with = free_rotation_exact(c.inertia, with, c.L, dt, &memo);
-    without = free_rotation_exact(c.inertia, without, c.L, dt);
-    ASSERT_TRUE(memo.held) << "step " << i;
-    worst = std::max(worst, rotation_angle_between(ref[i], with));
-    apart = std::max(apart, rotation_angle_between(with, without));
-  }
-  report("tumble_600_steps_with_memo_worst_vs_reference_rad", worst);
-  report("tumble_600_steps_with_and_without_memo_rad", apart);
-  EXPECT_LT(worst, 1e-12);
-  EXPECT_GT(apart, 0.0);  // the memo's constants come from earlier states: not the same bits
-  EXPECT_LT(apart, 1e-9);
-
-  // Poisoned constants: used when the step starts at R_end, never otherwise.
-  PolhodeMemo poisoned = memo;
-  poisoned.head = std::nan("");
-  EXPECT_FALSE(free_rotation_exact(c.inertia, with, c.L, dt, &poisoned).allFinite());
-  const Mat3 edited = with * axis_rotation(0, 1e-9);
-  for (auto [R, L, t] : {std::tuple{edited, c.L, dt}, std::tuple{with, Vec3(1.0001 * c.L), dt},
-                         std::tuple{with, c.L, 0.5 * dt}}) {
-    poisoned = memo;
-    poisoned.head = std::nan("");
-    const Mat3 got = free_rotation_exact(c.inertia, R, L, t, &poisoned);
-    const Mat3 plain = free_rotation_exact(c.inertia, R, L, t);
-    EXPECT_EQ(std::memcmp(got.data(), plain.data(), sizeof(Mat3)), 0);
-    EXPECT_TRUE(poisoned.held);  // and the memo now holds this flight's constants
-  }
 }
 
 }  // namespace
