@@ -16,7 +16,7 @@ constexpr double kSleepTime = 0.5;    // s
 // A body that rocks in place is still too: every point within kSleepReach of where it was when
 // its still time began (Jolt's sleep test, which bounds how far a body's points wander over the
 // sleep time instead of their speed). The reach is the distance the speed rule lets a still
-// body cover in the sleep time, so no body the speed rule keeps awake can end up farther. Why: a box wedged between two others, or balanced on two
+// body cover in the sleep time. Why: a box wedged between two others, or balanced on two
 // supports, can rock on its contacts like a pendulum, which rigid contacts do not damp; its
 // points then pass 0.05–0.15 m/s at the bottom of each swing while staying within a few
 // millimetres, and the speed rule alone kept 8 of 30 `pile` sizes (200–490 boxes) awake for

@@ -302,15 +302,20 @@ TEST(Determinism, ManyContactsGiveBitIdenticalStatesAndCopiesContinueIdentically
   }
 }
 
+// Steps `world` until every body sleeps, at most `steps` steps; the sim time it took, or −1.
+double step_until_asleep(World& world, int steps) {
+  for (int i = 0; i < steps; ++i) {
+    world.step();
+    if (world.awake_count() == 0) return world.time();
+  }
+  return -1.0;
+}
+
 TEST(Pile, ThreeHundredBoxesSettleAndSleepWithoutDeepPenetration) {
   Scene scene = load_scene("pile");
   scene.bodies.resize(300);
   World world(scene);
-  double asleep_at = -1.0;
-  for (int i = 0; i < 1800 && asleep_at < 0.0; ++i) {  // 30 s at most
-    world.step();
-    if (world.awake_count() == 0) asleep_at = world.time();
-  }
+  const double asleep_at = step_until_asleep(world, 1800);  // 30 s at most
   EXPECT_GT(asleep_at, 0.0);
   EXPECT_EQ(world.frozen_count(), 0u);
   EXPECT_LE(deepest_penetration(world), 5e-3);
@@ -326,11 +331,7 @@ TEST(Pile, PilesWithABoxRockingInPlaceSleep) {
     Scene scene = load_scene("pile");
     scene.bodies.resize(n);
     World world(scene);
-    double asleep_at = -1.0;
-    for (int i = 0; i < 1200 && asleep_at < 0.0; ++i) {  // 20 s at most
-      world.step();
-      if (world.awake_count() == 0) asleep_at = world.time();
-    }
+    const double asleep_at = step_until_asleep(world, 1200);  // 20 s at most
     EXPECT_GT(asleep_at, 0.0) << n << " boxes: " << world.awake_count() << " still awake at 20 s";
     EXPECT_EQ(world.frozen_count(), 0u) << n;
   }
