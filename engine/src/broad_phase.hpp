@@ -56,6 +56,8 @@ struct SweepScratch {
   std::vector<std::vector<BodyPair>> range_pairs;  ///< Scratch: pairs of each sweep range.
   std::vector<std::size_t> range_tests;            ///< Scratch: overlap tests of each range.
   std::size_t tests = 0;  ///< Overlap tests the last sweep made (its cost, for the caller).
+  std::size_t swept = 0;  ///< Awake boxes the last sweep sorted.
+  double awake_width = 0.0;  ///< Widest awake interval of the last sweep, m.
 };
 
 /// Every pair whose boxes overlap and of which at least one body is `active` (sleeping pairs
@@ -72,6 +74,14 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
                 std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
                 SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs,
                 WorkerPool& pool);
+
+/// Appends to `out` the bodies of the last sweep's two orders (awake and sleeping) whose box
+/// in `boxes` overlaps `box`; returns the overlap tests made. Each order is searched for the
+/// intervals that can meet the box's (binary search, then a scan of that range), by the
+/// starts of that sweep: a body whose box changed since may be missed, and the caller tests
+/// those on their own. A body may be listed twice (it is in both orders).
+std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes, const Aabb& box,
+                       std::vector<std::uint32_t>& out);
 
 /// The pair budget of a world of `body_count` bodies: 32 per body plus 1,024. A resting pile
 /// has about 7 per body (`pile`: 6,852 pairs for 1,000 bodies at most).

@@ -78,7 +78,10 @@ struct BroadPhaseCache {
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
   std::vector<QuietBound> quiet;         ///< When an unpaired body is still inside its fat box.
   std::vector<std::uint8_t> stale;       ///< boxes[i] not recomputed this step (quiet body).
-  std::vector<std::uint8_t> paired;      ///< Scratch: body is in fat_pairs.
+  std::vector<std::uint8_t> paired;      ///< Body is in fat_pairs.
+  std::vector<std::uint32_t> refit;      ///< Bodies whose fat box changed since the last sweep.
+  std::vector<std::uint8_t> in_refit;    ///< Body is in `refit`.
+  std::vector<std::uint32_t> near;       ///< Scratch: the bodies one query found.
   double quiet_dt = 0.0;                 ///< Step the quiet bounds were found for, s.
   Vec3 quiet_gravity = Vec3::Zero();     ///< Gravity they were found for, m/s².
 };

@@ -24,6 +24,22 @@ double interval_end(const Aabb& b) {
   return c.dot(kSweep) + h.dot(kSweep.cwiseAbs());
 }
 
+double interval_width(const Aabb& b) { return (b.hi - b.lo).dot(kSweep.cwiseAbs()); }
+
+/// Appends the bodies of `order` (sorted by start, no interval wider than `width`) whose box
+/// overlaps `box`; returns the tests made.
+std::size_t near_in(const std::vector<std::uint32_t>& order, const std::vector<double>& start,
+                    double width, std::span<const Aabb> boxes, const Aabb& box,
+                    std::vector<std::uint32_t>& out) {
+  const double lo = interval_start(box), hi = interval_end(box);
+  auto it = std::lower_bound(order.begin(), order.end(), lo - width,
+                             [&](std::uint32_t s, double v) { return start[s] < v; });
+  std::size_t tests = 0;
+  for (; it != order.end() && start[*it] <= hi; ++it, ++tests)
+    if (overlaps(box, boxes[*it])) out.push_back(*it);
+  return tests;
+}
+
 void add_pair(std::vector<BodyPair>& pairs, std::uint32_t a, std::uint32_t b) {
   pairs.emplace_back(std::min(a, b), std::max(a, b));
 }
@@ -110,9 +126,11 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   const std::size_t n = boxes.size();
   scratch.start.resize(n);
   std::size_t awake_count = 0;
+  scratch.awake_width = 0.0;
   for (std::uint32_t i : awake_ids) {
     if (!candidate[i]) continue;
     scratch.start[i] = interval_start(boxes[i]);
+    scratch.awake_width = std::max(scratch.awake_width, interval_width(boxes[i]));
     ++awake_count;
   }
   // The awake list keeps last step's order for the bodies still awake, then appends the rest.
@@ -167,6 +185,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   });
   scratch.tests = 0;
   for (std::size_t t : scratch.range_tests) scratch.tests += t;
+  scratch.swept = awake.size();
   if (ranges > 1)
     for (const std::vector<BodyPair>& part : scratch.range_pairs)
       pairs.insert(pairs.end(), part.begin(), part.end());
@@ -174,6 +193,16 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   if (pairs.size() > max_pairs) pairs.resize(max_pairs);
   sort_pairs(pairs, n, scratch);
   return complete;
+}
+
+// The sweep's two orders answer a query for one box: its interval along the sweep direction
+// can meet only those that start at most the order's widest interval before it. A body that
+// leaves its fat box between sweeps is paired this way in about the tests the sweep made for
+// it, where testing it against every body cost n (3.5 % of a fall of 10,000 cubes).
+std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes, const Aabb& box,
+                       std::vector<std::uint32_t>& out) {
+  return near_in(scratch.awake, scratch.start, scratch.awake_width, boxes, box, out) +
+         near_in(scratch.sleeping, scratch.start, scratch.sleeping_width, boxes, box, out);
 }
 
 }  // namespace tumble
