@@ -68,10 +68,10 @@ class WorkerPool {
   }
 
  private:
-  /// One phase of a for_each_phase job: its chunks, the next one to take and those done.
+  /// One phase of a for_each_phase job: its chunks, the two ends of those left and those done.
   struct Phase {
     std::size_t n = 0, chunk = 1, chunks = 0;
-    alignas(64) std::atomic<std::size_t> next{0};
+    alignas(64) std::atomic<std::uint64_t> ends{0};  // next chunk from the front | back << 32
     alignas(64) std::atomic<std::size_t> done{0};
   };
   using PhaseThunk = void (*)(void*, std::size_t, std::size_t, std::size_t);
@@ -94,14 +94,14 @@ class WorkerPool {
       ph.n = size(p);
       ph.chunk = std::max<std::size_t>(std::max<std::size_t>(grain, 1), (ph.n + most - 1) / most);
       ph.chunks = (ph.n + ph.chunk - 1) / ph.chunk;
-      ph.next.store(0, std::memory_order_relaxed);
+      ph.ends.store(static_cast<std::uint64_t>(ph.chunks) << 32, std::memory_order_relaxed);
       ph.done.store(0, std::memory_order_relaxed);
       chunks += ph.chunks;
     }
     return chunks;
   }
   void run_phases(PhaseThunk thunk, void* fn);
-  void work_phases();
+  void work_phases(std::size_t slot);
 
   using Thunk = void (*)(void*, std::size_t, std::size_t);
   template <typename Fn>
