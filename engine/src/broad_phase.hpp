@@ -43,6 +43,16 @@ inline bool overlaps(const Aabb& a, const Aabb& b) {
 /// A candidate pair of body indices, first < second.
 using BodyPair = std::pair<std::uint32_t, std::uint32_t>;
 
+/// An awake box in one slab of the sweep (SweepScratch): a copy, so that the sweep of a slab
+/// reads memory in order.
+struct SlabItem {
+  Aabb box;
+  double start = 0.0;       ///< Interval start along the sweep direction, m.
+  double end = 0.0;         ///< Interval end, m.
+  std::uint32_t id = 0;     ///< Body index.
+  std::uint32_t first = 0;  ///< Lowest slab the box is in.
+};
+
 /// Scratch kept between steps: the sweep orders of the awake and of the sleeping bodies.
 struct SweepScratch {
   std::vector<std::uint32_t> awake;       ///< Awake candidates, sorted by their interval start.
@@ -55,7 +65,15 @@ struct SweepScratch {
   double sleeping_width = 0.0;            ///< Widest sleeping interval, m.
   std::vector<std::vector<BodyPair>> range_pairs;  ///< Scratch: pairs of each sweep range.
   std::vector<std::size_t> range_tests;            ///< Scratch: overlap tests of each range.
-  std::size_t tests = 0;  ///< Overlap tests the last sweep made (its cost, for the caller).
+  std::vector<std::uint32_t> slab_offset;  ///< Scratch: start of each slab in slab_items.
+  std::vector<SlabItem> slab_items;         ///< Scratch: the awake boxes, slab by slab.
+  std::vector<std::pair<double, double>> across;  ///< Scratch: each awake box across the sweep.
+  double slab_base = 0.0;   ///< Where slab 0 starts across the sweep, m.
+  double slab_width = 0.0;  ///< Width of a slab across the sweep, m (0: one slab).
+  /// The last sweep's cost in overlap tests: the tests it made plus kSweepBodyCost for each
+  /// awake body (its fat box, interval, place in the order and slab), for the caller to
+  /// weigh against pairing bodies one by one.
+  std::size_t tests = 0;
   std::size_t swept = 0;  ///< Awake boxes the last sweep sorted.
   double awake_width = 0.0;  ///< Widest awake interval of the last sweep, m.
 };
@@ -75,11 +93,12 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
                 SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs,
                 WorkerPool& pool);
 
-/// Appends to `out` the bodies of the last sweep's two orders (awake and sleeping) whose box
-/// in `boxes` overlaps `box`; returns the overlap tests made. Each order is searched for the
-/// intervals that can meet the box's (binary search, then a scan of that range), by the
-/// starts of that sweep: a body whose box changed since may be missed, and the caller tests
-/// those on their own. A body may be listed twice (it is in both orders).
+/// Appends to `out` the bodies of the last sweep (its awake slabs and its sleeping order)
+/// whose box in `boxes` overlaps `box`; returns the overlap tests made. Each slab the box
+/// reaches, and the sleeping order, is searched for the intervals that can meet the box's
+/// (binary search, then a scan of that range), by the boxes of that sweep: a body whose box
+/// changed since may be missed, and the caller tests those on their own. A body may be
+/// listed twice (it is in both).
 std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes, const Aabb& box,
                        std::vector<std::uint32_t>& out);
 

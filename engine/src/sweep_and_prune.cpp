@@ -1,6 +1,7 @@
 /// Sweep and prune: the pairs of overlapping boxes (find_pairs, declared in broad_phase.hpp).
 /// The broad-phase stage calls it on its fat boxes; initial_pairs on the boxes as placed.
 #include <algorithm>
+#include <cmath>
 
 #include "broad_phase.hpp"
 #include "worker_pool.hpp"
@@ -26,6 +27,105 @@ double interval_end(const Aabb& b) {
 
 double interval_width(const Aabb& b) { return (b.hi - b.lo).dot(kSweep.cwiseAbs()); }
 
+void add_pair(std::vector<BodyPair>& pairs, std::uint32_t a, std::uint32_t b) {
+  pairs.emplace_back(std::min(a, b), std::max(a, b));
+}
+
+// Slabs across the sweep. Along one direction the intervals of boxes spread over a plane (a
+// floor of 10,000 separated cubes) overlap by the dozen, each box meeting ~60 that are a
+// whole grid away in the other direction: O(n √n) tests, 4 ms for each sweep of the 10,000
+// cubes. Cut into slabs across the sweep (along kAcross, in the floor's plane and square to
+// the sweep) each box meets only those of its own slabs. A box is listed in every slab it
+// reaches, and a pair is reported only in the first slab that holds both, so once.
+const Vec3 kAcross = kSweep.cross(Vec3::UnitY()).normalized();
+constexpr double kSweepBodyCost = 16.0;   // a body's share of a sweep, in overlap tests
+constexpr std::size_t kMinSlabBodies = 256;  // fewer awake boxes: one slab
+constexpr double kMaxListings = 3.0;      // slab listings per box, on average, at most
+
+/// The slab (of `count`) that the point x across the sweep falls in.
+std::size_t slab_of(const SweepScratch& scratch, std::size_t count, double x) {
+  if (count == 1 || !(x > scratch.slab_base)) return 0;
+  const double s = (x - scratch.slab_base) / scratch.slab_width;
+  return s >= static_cast<double>(count - 1) ? count - 1 : static_cast<std::size_t>(s);
+}
+
+/// Where a box lies across the sweep: [lo, hi], m.
+std::pair<double, double> across_of(const Aabb& b) {
+  const double c = (0.5 * (b.lo + b.hi)).dot(kAcross);
+  const double h = (0.5 * (b.hi - b.lo)).dot(kAcross.cwiseAbs());
+  return {c - h, c + h};
+}
+
+/// Puts the awake boxes (scratch.awake, in sweep order) into slabs about twice as wide as
+/// the average box across the sweep, each slab in sweep order (scratch.slab_offset,
+/// slab_items). One slab when the boxes are few or lie along the sweep.
+void build_slabs(SweepScratch& scratch, std::span<const Aabb> boxes) {
+  const std::vector<std::uint32_t>& awake = scratch.awake;
+  const std::size_t m = awake.size();
+  scratch.across.resize(m);
+  double lo = INFINITY, hi = -INFINITY, widths = 0.0;
+  for (std::size_t k = 0; k < m; ++k) {
+    scratch.across[k] = across_of(boxes[awake[k]]);
+    lo = std::min(lo, scratch.across[k].first);
+    hi = std::max(hi, scratch.across[k].second);
+    widths += scratch.across[k].second - scratch.across[k].first;
+  }
+  double width = m > 0 ? 2.0 * widths / static_cast<double>(m) : 0.0;
+  std::size_t count = 1;
+  scratch.slab_base = lo;
+  if (m >= kMinSlabBodies && width > 0.0 && std::isfinite(hi - lo)) {
+    for (;; width *= 2.0) {  // wider slabs until the listings are few (a few huge boxes)
+      const double slabs = std::floor((hi - lo) / width) + 1.0;
+      count = slabs < static_cast<double>(m / 4) ? static_cast<std::size_t>(slabs) : m / 4;
+      if (count <= 1) break;
+      scratch.slab_width = width;
+      double listings = 0.0;
+      for (const auto& [a, b] : scratch.across)
+        listings += static_cast<double>(slab_of(scratch, count, b) - slab_of(scratch, count, a) + 1);
+      if (listings <= kMaxListings * static_cast<double>(m)) break;
+    }
+  }
+  count = std::max<std::size_t>(count, 1);
+  scratch.slab_width = count == 1 ? 0.0 : width;
+  auto first_of = [&](std::size_t k) { return slab_of(scratch, count, scratch.across[k].first); };
+  auto last_of = [&](std::size_t k) { return slab_of(scratch, count, scratch.across[k].second); };
+  std::vector<std::uint32_t>& offset = scratch.slab_offset;
+  offset.assign(count + 1, 0);
+  for (std::size_t k = 0; k < m; ++k)
+    for (std::size_t s = first_of(k), e = last_of(k); s <= e; ++s) ++offset[s + 1];
+  for (std::size_t s = 1; s <= count; ++s) offset[s] += offset[s - 1];
+  scratch.slab_items.resize(offset[count]);
+  for (std::size_t k = 0; k < m; ++k) {
+    const Aabb& b = boxes[awake[k]];
+    const std::size_t first = first_of(k);
+    const SlabItem item{b, scratch.start[awake[k]], interval_end(b), awake[k],
+                        static_cast<std::uint32_t>(first)};
+    for (std::size_t s = first, e = last_of(k); s <= e; ++s) scratch.slab_items[offset[s]++] = item;
+  }
+  for (std::size_t s = count; s > 0; --s) offset[s] = offset[s - 1];  // ends back to starts
+  offset[0] = 0;
+}
+
+/// The awake pairs of slabs [first, last), appended to `out`; stops once `out` holds more
+/// than max_pairs. Returns the number of overlap tests.
+std::size_t sweep_slabs(const SweepScratch& scratch, std::size_t first, std::size_t last,
+                        std::vector<BodyPair>& out, std::size_t max_pairs) {
+  std::size_t tests = 0;
+  const std::vector<SlabItem>& items = scratch.slab_items;
+  for (std::size_t s = first; s < last && out.size() <= max_pairs; ++s) {
+    const std::size_t end = scratch.slab_offset[s + 1];
+    for (std::size_t i = scratch.slab_offset[s]; i < end; ++i) {
+      const SlabItem& a = items[i];
+      for (std::size_t j = i + 1; j < end && items[j].start <= a.end; ++j) {
+        ++tests;
+        if (overlaps(a.box, items[j].box) && std::max(a.first, items[j].first) == s)
+          add_pair(out, a.id, items[j].id);
+      }
+    }
+  }
+  return tests;
+}
+
 /// Appends the bodies of `order` (sorted by start, no interval wider than `width`) whose box
 /// overlaps `box`; returns the tests made.
 std::size_t near_in(const std::vector<std::uint32_t>& order, const std::vector<double>& start,
@@ -40,9 +140,6 @@ std::size_t near_in(const std::vector<std::uint32_t>& order, const std::vector<d
   return tests;
 }
 
-void add_pair(std::vector<BodyPair>& pairs, std::uint32_t a, std::uint32_t b) {
-  pairs.emplace_back(std::min(a, b), std::max(a, b));
-}
 
 /// Keeps `list` = the bodies with flag set, sorted by start (insertion sort from last order).
 void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& start) {
@@ -78,25 +175,19 @@ void sort_pairs(std::vector<BodyPair>& pairs, std::size_t n, SweepScratch& scrat
   by([](const BodyPair& p) { return p.first; }, scratch.sorted, pairs);
 }
 
-/// The sweep for awake[first, last): pairs with the awake bodies after each one and with the
-/// sleeping ones, appended to `out`; stops once `out` holds more than max_pairs. Returns the
-/// number of overlap tests.
-std::size_t sweep_range(const SweepScratch& scratch, std::span<const Aabb> boxes,
-                        std::size_t first, std::size_t last, std::vector<BodyPair>& out,
-                        std::size_t max_pairs) {
+/// The pairs of awake[first, last) with the sleeping bodies, appended to `out`; stops once
+/// `out` holds more than max_pairs. Returns the number of overlap tests.
+std::size_t sweep_sleeping(const SweepScratch& scratch, std::span<const Aabb> boxes,
+                           std::size_t first, std::size_t last, std::vector<BodyPair>& out,
+                           std::size_t max_pairs) {
   std::size_t tests = 0;
   const std::vector<std::uint32_t>& awake = scratch.awake;
   const std::vector<std::uint32_t>& sleeping = scratch.sleeping;
+  if (sleeping.empty()) return 0;
   for (std::size_t i = first; i < last && out.size() <= max_pairs; ++i) {
     const std::uint32_t a = awake[i];
     const Aabb& ba = boxes[a];
     const double end = interval_end(ba);
-    for (std::size_t j = i + 1; j < awake.size(); ++j) {
-      const std::uint32_t b = awake[j];
-      if (scratch.start[b] > end) break;
-      ++tests;
-      if (overlaps(ba, boxes[b])) add_pair(out, a, b);
-    }
     // Sleeping boxes whose interval can overlap [start, end]: they start after
     // start − widest and before end.
     auto from = std::lower_bound(sleeping.begin(), sleeping.end(),
@@ -168,22 +259,33 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
               });
     scratch.sleeping_signature = sleeping_key;
   }
-  // The sweep's outer loop is shared among the pool's threads in fixed ranges, each with its
-  // own list; joined in range order they are the pairs of the loop in order.
-  // One thread sweeps straight into `pairs`: no ranges to join.
+  build_slabs(scratch, boxes);
+  // The awake pairs slab by slab, then the pairs with sleeping bodies in sweep order: shared
+  // among the pool's threads in fixed ranges of each, each range with its own list; joined in
+  // range order they are the pairs of the two loops in order, whatever the thread count. One
+  // thread sweeps straight into `pairs`: no ranges to join.
+  const std::size_t slabs = scratch.slab_offset.size() - 1;
   const std::size_t ranges =
       pool.size() == 1 ? 1 : std::min<std::size_t>(4 * pool.size(), awake.size() / 64 + 1);
-  scratch.range_pairs.resize(ranges);
-  scratch.range_tests.resize(ranges);
-  pool.for_each(ranges, 1, [&](std::size_t begin, std::size_t end) {
+  scratch.range_pairs.resize(2 * ranges);
+  scratch.range_tests.resize(2 * ranges);
+  auto sweep_ranges = [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       std::vector<BodyPair>& out = ranges == 1 ? pairs : scratch.range_pairs[r];
       if (ranges > 1) out.clear();
-      scratch.range_tests[r] = sweep_range(scratch, boxes, awake.size() * r / ranges,
-                                           awake.size() * (r + 1) / ranges, out, max_pairs);
+      const std::size_t q = r % ranges;
+      scratch.range_tests[r] =
+          r < ranges ? sweep_slabs(scratch, slabs * q / ranges, slabs * (q + 1) / ranges, out,
+                                   max_pairs)
+                     : sweep_sleeping(scratch, boxes, awake.size() * q / ranges,
+                                      awake.size() * (q + 1) / ranges, out, max_pairs);
     }
-  });
-  scratch.tests = 0;
+  };
+  if (ranges == 1)
+    sweep_ranges(0, 2);
+  else
+    pool.for_each(2 * ranges, 1, [&](std::size_t b, std::size_t e) { sweep_ranges(b, e); });
+  scratch.tests = static_cast<std::size_t>(kSweepBodyCost * static_cast<double>(awake.size()));
   for (std::size_t t : scratch.range_tests) scratch.tests += t;
   scratch.swept = awake.size();
   if (ranges > 1)
@@ -201,8 +303,20 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
 // it, where testing it against every body cost n (3.5 % of a fall of 10,000 cubes).
 std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes, const Aabb& box,
                        std::vector<std::uint32_t>& out) {
-  return near_in(scratch.awake, scratch.start, scratch.awake_width, boxes, box, out) +
-         near_in(scratch.sleeping, scratch.start, scratch.sleeping_width, boxes, box, out);
+  const std::size_t count = scratch.slab_offset.size() - 1;
+  const auto [lo, hi] = across_of(box);
+  const double from = interval_start(box) - scratch.awake_width, to = interval_end(box);
+  std::size_t tests = 0;
+  const std::vector<SlabItem>& items = scratch.slab_items;
+  for (std::size_t s = slab_of(scratch, count, lo), last = slab_of(scratch, count, hi); s <= last; ++s) {
+    const auto begin = items.begin() + scratch.slab_offset[s];
+    const auto end = items.begin() + scratch.slab_offset[s + 1];
+    auto it = std::lower_bound(begin, end, from,
+                               [](const SlabItem& item, double v) { return item.start < v; });
+    for (; it != end && it->start <= to; ++it, ++tests)
+      if (overlaps(box, boxes[it->id])) out.push_back(it->id);
+  }
+  return tests + near_in(scratch.sleeping, scratch.start, scratch.sleeping_width, boxes, box, out);
 }
 
 }  // namespace tumble
