@@ -5,6 +5,7 @@
 // step, as many pairs as testing every pair of swept boxes finds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -69,6 +70,60 @@ TEST(BroadPhase, FindsEveryOverlappingPairOnceInOrderForAnyThreadCount) {
       EXPECT_TRUE(find_pairs(b.boxes, b.active, b.candidate, b.awake, 1, scratch, pairs,
                              pair_budget(b.boxes.size()), pool));
       EXPECT_EQ(pairs, expected) << "seed " << seed << ", " << threads << " threads";
+    }
+  }
+}
+
+/// n boxes spread over a floor 60 m square, as separated bodies are: most under a metre,
+/// some stretched tall (a fall), a few long across the floor or huge; a share asleep.
+Boxes floor_boxes(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Boxes b;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3 centre(60.0 * unit(rng), 2.0 * unit(rng), 60.0 * unit(rng));
+    Vec3 half = Vec3::Constant(0.2 + 0.4 * unit(rng));
+    const double kind = unit(rng);
+    if (kind < 0.15) half.y() *= 8.0;        // stretched along a fall
+    else if (kind < 0.18) half.x() *= 20.0;  // long, across many slabs
+    else if (kind < 0.19) half *= 30.0;      // huge
+    b.boxes.push_back({centre - half, centre + half});
+    b.active.push_back(unit(rng) < 0.8);
+    b.candidate.push_back(unit(rng) < 0.98);
+    if (b.active.back()) b.awake.push_back(static_cast<std::uint32_t>(i));
+  }
+  return b;
+}
+
+// Spread over a plane, the awake boxes are cut into slabs across the sweep, a box listed in
+// every slab it reaches: the pairs must still come out each once, and a query for one box
+// (how the stage pairs a body that left its fat box) must find every box it overlaps.
+TEST(BroadPhase, SlabsAcrossTheSweepFindEveryPairOnceAndAnswerQueries) {
+  const Boxes b = floor_boxes(3000, 6);
+  const std::vector<BodyPair> expected = all_pairs(b);
+  ASSERT_GT(expected.size(), 1000u);
+  for (std::size_t threads : {1u, 3u}) {
+    WorkerPool pool(threads);
+    SweepScratch scratch;
+    std::vector<BodyPair> pairs;
+    EXPECT_TRUE(find_pairs(b.boxes, b.active, b.candidate, b.awake, 1, scratch, pairs,
+                           pair_budget(b.boxes.size()), pool));
+    EXPECT_GT(scratch.slab_offset.size() - 1, 10u) << "the plane is cut into slabs";
+    EXPECT_EQ(pairs, expected) << threads << " threads";
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int q = 0; q < 200; ++q) {
+      const Vec3 centre(66.0 * unit(rng) - 3.0, 2.0 * unit(rng), 66.0 * unit(rng) - 3.0);
+      const Vec3 half(0.2 + (q % 10 == 0 ? 12.0 : 1.0) * unit(rng), 1.0, 0.3 + unit(rng));
+      const Aabb box{centre - half, centre + half};
+      std::vector<std::uint32_t> found;
+      boxes_near(scratch, b.boxes, box, found);
+      std::sort(found.begin(), found.end());
+      found.erase(std::unique(found.begin(), found.end()), found.end());
+      std::vector<std::uint32_t> want;
+      for (std::uint32_t i = 0; i < b.boxes.size(); ++i)
+        if (b.candidate[i] && overlaps(box, b.boxes[i])) want.push_back(i);
+      ASSERT_EQ(found, want) << "query " << q << ", " << threads << " threads";
     }
   }
 }
