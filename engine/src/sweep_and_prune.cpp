@@ -308,13 +308,15 @@ std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes,
   const double from = interval_start(box) - scratch.awake_width, to = interval_end(box);
   std::size_t tests = 0;
   const std::vector<SlabItem>& items = scratch.slab_items;
-  for (std::size_t s = slab_of(scratch, count, lo), last = slab_of(scratch, count, hi); s <= last; ++s) {
+  const std::size_t first = slab_of(scratch, count, lo), last = slab_of(scratch, count, hi);
+  for (std::size_t s = first; s <= last; ++s) {
     const auto begin = items.begin() + scratch.slab_offset[s];
     const auto end = items.begin() + scratch.slab_offset[s + 1];
     auto it = std::lower_bound(begin, end, from,
                                [](const SlabItem& item, double v) { return item.start < v; });
     for (; it != end && it->start <= to; ++it, ++tests)
-      if (overlaps(box, boxes[it->id])) out.push_back(it->id);
+      if (std::max<std::size_t>(it->first, first) == s && overlaps(box, boxes[it->id]))
+        out.push_back(it->id);  // in the first slab that holds both, so once
   }
   return tests + near_in(scratch.sleeping, scratch.start, scratch.sleeping_width, boxes, box, out);
 }
