@@ -231,8 +231,8 @@ void insert_sorted(std::vector<BodyPair>& pairs, std::size_t cached, std::vector
 }
 
 /// The overlap tests that pairing `count` bodies one by one is expected to cost: per body,
-/// twice the tests a body made in the last sweep (its range in the sweep's order reaches
-/// back by the widest interval) plus one per body refitted since.
+/// twice a body's share of the last sweep's cost (a query's range in a slab reaches back by
+/// the widest interval) plus one per body refitted since.
 std::size_t pairing_cost(const BroadPhaseCache& k, std::size_t count) {
   const std::size_t per_body = 2 * k.sweep.tests / std::max<std::size_t>(k.sweep.swept, 1);
   return count * (per_body + k.refit.size() + 16);
