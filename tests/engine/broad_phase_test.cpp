@@ -24,27 +24,39 @@ struct Boxes {
   std::vector<std::uint32_t> awake;
 };
 
+/// n random boxes: shape(unit) draws one box's centre and half extents from unit(), a
+/// uniform draw in [0, 1); a share `awake` of them awake, `candidate` candidates.
+template <typename Shape>
+Boxes random_boxes(std::size_t n, unsigned seed, double awake, double candidate, Shape&& shape) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  auto unit = [&] { return uniform(rng); };
+  Boxes b;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto [centre, half] = shape(unit);
+    const bool active = unit() < awake;
+    b.boxes.push_back({centre - half, centre + half});
+    b.active.push_back(active);
+    b.candidate.push_back(unit() < candidate);
+    if (active) b.awake.push_back(static_cast<std::uint32_t>(i));
+  }
+  return b;
+}
+
 /// n boxes of mixed widths: most about 1 m in a dense heap, some stretched tall (a fat box
 /// following a fall), some tiny, a few huge or far away; a share asleep, a few not candidates.
 Boxes mixed_boxes(std::size_t n, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  Boxes b;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 centre(8.0 * unit(rng), 8.0 * unit(rng), 8.0 * unit(rng));
-    Vec3 half = Vec3::Constant(0.3 + 0.5 * unit(rng));
-    const double kind = unit(rng);
+  return random_boxes(n, seed, 0.7, 0.97, [](auto& unit) {
+    Vec3 centre;
+    for (int k = 0; k < 3; ++k) centre[k] = 8.0 * unit();
+    Vec3 half = Vec3::Constant(0.3 + 0.5 * unit());
+    const double kind = unit();
     if (kind < 0.15) half.y() *= 6.0;                   // stretched along a fall
     else if (kind < 0.25) half *= 0.01;                 // tiny
     else if (kind < 0.28) half *= 40.0;                 // huge
-    Vec3 c = centre;
-    if (kind > 0.98) c.x() = 1e14;                      // too far for the grid's cells
-    b.boxes.push_back({c - half, c + half});
-    b.active.push_back(unit(rng) < 0.7);
-    b.candidate.push_back(unit(rng) < 0.97);
-    if (b.active.back()) b.awake.push_back(static_cast<std::uint32_t>(i));
-  }
-  return b;
+    if (kind > 0.98) centre.x() = 1e14;                 // too far for the grid's cells
+    return std::pair{centre, half};
+  });
 }
 
 /// Every pair with a candidate awake body, by testing each pair.
@@ -58,6 +70,14 @@ std::vector<BodyPair> all_pairs(const Boxes& b) {
   return pairs;
 }
 
+/// The pairs one sweep of find_pairs finds, within the budget (checked).
+std::vector<BodyPair> sweep_all(const Boxes& b, SweepScratch& scratch, WorkerPool& pool) {
+  std::vector<BodyPair> pairs;
+  EXPECT_TRUE(find_pairs(b.boxes, b.active, b.candidate, b.awake, 1, scratch, pairs,
+                         pair_budget(b.boxes.size()), pool));
+  return pairs;
+}
+
 TEST(BroadPhase, FindsEveryOverlappingPairOnceInOrderForAnyThreadCount) {
   for (unsigned seed : {1u, 2u, 3u}) {
     const Boxes b = mixed_boxes(600, seed);
@@ -66,10 +86,8 @@ TEST(BroadPhase, FindsEveryOverlappingPairOnceInOrderForAnyThreadCount) {
     for (std::size_t threads : {1u, 3u}) {
       WorkerPool pool(threads);
       SweepScratch scratch;
-      std::vector<BodyPair> pairs;
-      EXPECT_TRUE(find_pairs(b.boxes, b.active, b.candidate, b.awake, 1, scratch, pairs,
-                             pair_budget(b.boxes.size()), pool));
-      EXPECT_EQ(pairs, expected) << "seed " << seed << ", " << threads << " threads";
+      EXPECT_EQ(sweep_all(b, scratch, pool), expected) << "seed " << seed << ", " << threads
+                                                       << " threads";
     }
   }
 }
@@ -77,22 +95,16 @@ TEST(BroadPhase, FindsEveryOverlappingPairOnceInOrderForAnyThreadCount) {
 /// n boxes spread over a floor 60 m square, as separated bodies are: most under a metre,
 /// some stretched tall (a fall), a few long across the floor or huge; a share asleep.
 Boxes floor_boxes(std::size_t n, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  Boxes b;
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3 centre(60.0 * unit(rng), 2.0 * unit(rng), 60.0 * unit(rng));
-    Vec3 half = Vec3::Constant(0.2 + 0.4 * unit(rng));
-    const double kind = unit(rng);
+  return random_boxes(n, seed, 0.8, 0.98, [](auto& unit) {
+    Vec3 centre;
+    for (int k = 0; k < 3; ++k) centre[k] = (k == 1 ? 2.0 : 60.0) * unit();
+    Vec3 half = Vec3::Constant(0.2 + 0.4 * unit());
+    const double kind = unit();
     if (kind < 0.15) half.y() *= 8.0;        // stretched along a fall
     else if (kind < 0.18) half.x() *= 20.0;  // long, across many slabs
     else if (kind < 0.19) half *= 30.0;      // huge
-    b.boxes.push_back({centre - half, centre + half});
-    b.active.push_back(unit(rng) < 0.8);
-    b.candidate.push_back(unit(rng) < 0.98);
-    if (b.active.back()) b.awake.push_back(static_cast<std::uint32_t>(i));
-  }
-  return b;
+    return std::pair{centre, half};
+  });
 }
 
 // Spread over a plane, the awake boxes are cut into slabs across the sweep, a box listed in
@@ -105,11 +117,8 @@ TEST(BroadPhase, SlabsAcrossTheSweepFindEveryPairOnceAndAnswerQueries) {
   for (std::size_t threads : {1u, 3u}) {
     WorkerPool pool(threads);
     SweepScratch scratch;
-    std::vector<BodyPair> pairs;
-    EXPECT_TRUE(find_pairs(b.boxes, b.active, b.candidate, b.awake, 1, scratch, pairs,
-                           pair_budget(b.boxes.size()), pool));
+    EXPECT_EQ(sweep_all(b, scratch, pool), expected) << threads << " threads";
     EXPECT_GT(scratch.slab_offset.size() - 1, 10u) << "the plane is cut into slabs";
-    EXPECT_EQ(pairs, expected) << threads << " threads";
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     for (int q = 0; q < 200; ++q) {
