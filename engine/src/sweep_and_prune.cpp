@@ -38,7 +38,7 @@ void add_pair(std::vector<BodyPair>& pairs, std::uint32_t a, std::uint32_t b) {
 // the sweep) each box meets only those of its own slabs. A box is listed in every slab it
 // reaches, and a pair is reported only in the first slab that holds both, so once. (One
 // sweep per region of space is Bullet's multi-SAP; Tracy, Buss & Woods 2009, "Efficient
-// large-scale sweep and prune methods with AABB insertion and removal", measure it.)
+// large-scale sweep and prune methods with AABB insertion and removal", discuss it.)
 const Vec3 kAcross = kSweep.cross(Vec3::UnitY()).normalized();
 constexpr double kSweepBodyCost = 16.0;   // a body's share of a sweep, in overlap tests
 constexpr std::size_t kMinSlabBodies = 256;  // fewer awake boxes: one slab
