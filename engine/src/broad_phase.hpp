@@ -97,8 +97,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
 /// whose box in `boxes` overlaps `box`; returns the overlap tests made. Each slab the box
 /// reaches, and the sleeping order, is searched for the intervals that can meet the box's
 /// (binary search, then a scan of that range), by the boxes of that sweep: a body whose box
-/// changed since may be missed, and the caller tests those on their own. A body may be
-/// listed twice (it is in both).
+/// changed since may be missed, and the caller tests those on their own.
 std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes, const Aabb& box,
                        std::vector<std::uint32_t>& out);
 

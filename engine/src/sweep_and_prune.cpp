@@ -108,21 +108,24 @@ void build_slabs(SweepScratch& scratch, std::span<const Aabb> boxes) {
   offset[0] = 0;
 }
 
-/// The awake pairs of slabs [first, last), appended to `out`; stops once `out` holds more
-/// than max_pairs. Returns the number of overlap tests.
+/// The awake pairs of slab items [first, last) (each with the items after it in its slab),
+/// appended to `out`; stops once `out` holds more than max_pairs. Ranges of items, not of
+/// slabs, so that threads share the work when there are few slabs. Returns the number of
+/// overlap tests.
 std::size_t sweep_slabs(const SweepScratch& scratch, std::size_t first, std::size_t last,
                         std::vector<BodyPair>& out, std::size_t max_pairs) {
   std::size_t tests = 0;
   const std::vector<SlabItem>& items = scratch.slab_items;
-  for (std::size_t s = first; s < last && out.size() <= max_pairs; ++s) {
-    const std::size_t end = scratch.slab_offset[s + 1];
-    for (std::size_t i = scratch.slab_offset[s]; i < end; ++i) {
-      const SlabItem& a = items[i];
-      for (std::size_t j = i + 1; j < end && items[j].start <= a.end; ++j) {
-        ++tests;
-        if (overlaps(a.box, items[j].box) && std::max(a.first, items[j].first) == s)
-          add_pair(out, a.id, items[j].id);
-      }
+  const std::vector<std::uint32_t>& offset = scratch.slab_offset;
+  std::size_t s = static_cast<std::size_t>(
+      std::upper_bound(offset.begin(), offset.end(), first) - offset.begin() - 1);
+  for (std::size_t i = first; i < last && out.size() <= max_pairs; ++i) {
+    while (i >= offset[s + 1]) ++s;
+    const SlabItem& a = items[i];
+    for (std::size_t j = i + 1; j < offset[s + 1] && items[j].start <= a.end; ++j) {
+      ++tests;
+      if (overlaps(a.box, items[j].box) && std::max<std::size_t>(a.first, items[j].first) == s)
+        add_pair(out, a.id, items[j].id);
     }
   }
   return tests;
@@ -141,7 +144,6 @@ std::size_t near_in(const std::vector<std::uint32_t>& order, const std::vector<d
     if (overlaps(box, boxes[*it])) out.push_back(*it);
   return tests;
 }
-
 
 /// Keeps `list` = the bodies with flag set, sorted by start (insertion sort from last order).
 void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& start) {
@@ -266,7 +268,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   // among the pool's threads in fixed ranges of each, each range with its own list; joined in
   // range order they are the pairs of the two loops in order, whatever the thread count. One
   // thread sweeps straight into `pairs`: no ranges to join.
-  const std::size_t slabs = scratch.slab_offset.size() - 1;
+  const std::size_t items = scratch.slab_items.size();
   const std::size_t ranges =
       pool.size() == 1 ? 1 : std::min<std::size_t>(4 * pool.size(), awake.size() / 64 + 1);
   scratch.range_pairs.resize(2 * ranges);
@@ -277,7 +279,7 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
       if (ranges > 1) out.clear();
       const std::size_t q = r % ranges;
       scratch.range_tests[r] =
-          r < ranges ? sweep_slabs(scratch, slabs * q / ranges, slabs * (q + 1) / ranges, out,
+          r < ranges ? sweep_slabs(scratch, items * q / ranges, items * (q + 1) / ranges, out,
                                    max_pairs)
                      : sweep_sleeping(scratch, boxes, awake.size() * q / ranges,
                                       awake.size() * (q + 1) / ranges, out, max_pairs);
@@ -299,8 +301,8 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   return complete;
 }
 
-// The sweep's two orders answer a query for one box: its interval along the sweep direction
-// can meet only those that start at most the order's widest interval before it. A body that
+// The sweep's slabs and sleeping order answer a query for one box: its interval along the
+// sweep direction can meet only those that start at most the widest interval before it. A body that
 // leaves its fat box between sweeps is paired this way in about the tests the sweep made for
 // it, where testing it against every body cost n (3.5 % of a fall of 10,000 cubes).
 std::size_t boxes_near(const SweepScratch& scratch, std::span<const Aabb> boxes, const Aabb& box,
