@@ -116,7 +116,9 @@ void Broadcaster::on_tick(boost::system::error_code ec) {
   publish(now);
   for (const auto& s : live) s->notify();
   next_ += interval_;
-  while (next_ <= now) next_ += interval_;  // Late by more than a period: skip, don't burst.
+  std::uint64_t skipped = 0;
+  for (; next_ <= now; ++skipped) next_ += interval_;  // Late by over a period: skip, don't burst.
+  if (skipped > 0) metrics_.count_ticks_skipped(skipped);
   do_tick();
 }
 

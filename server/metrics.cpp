@@ -109,6 +109,9 @@ std::string Metrics::render(const Snapshot& s, std::size_t viewers) const {
   counter(out, "tumble_frames_dropped_total",
           "Frames replaced by a newer one before a slow viewer took them.",
           static_cast<double>(frames_dropped()));
+  counter(out, "tumble_frame_ticks_skipped_total",
+          "Frame ticks (20 ms) skipped because the frame timer woke over a period late.",
+          static_cast<double>(ticks_skipped()));
   counter(out, "tumble_frame_bytes_total", "Frame payload bytes written to viewers.",
           static_cast<double>(frame_bytes()));
   gauge(out, "tumble_frames_in_flight", "Frames being written now (at most one per viewer).",

@@ -44,6 +44,10 @@ class Metrics {
   void count_frame_sent() { frames_sent_.fetch_add(1, std::memory_order_relaxed); }
   /// A queued frame was replaced by a newer one before it could be written.
   void count_frame_dropped() { frames_dropped_.fetch_add(1, std::memory_order_relaxed); }
+  /// `n` frame ticks were skipped because the frame timer woke over a period late (stream strand).
+  void count_ticks_skipped(std::uint64_t n) { ticks_skipped_.fetch_add(n, std::memory_order_relaxed); }
+  /// Frame ticks skipped so far (all worlds).
+  std::uint64_t ticks_skipped() const { return ticks_skipped_.load(std::memory_order_relaxed); }
   /// Frames sent so far (all sessions).
   std::uint64_t frames_sent() const { return frames_sent_.load(std::memory_order_relaxed); }
   /// Frames dropped so far (all sessions).
@@ -77,6 +81,7 @@ class Metrics {
   std::atomic<double> dropped_time_{0.0};
   std::atomic<std::uint64_t> frames_sent_{0};
   std::atomic<std::uint64_t> frames_dropped_{0};
+  std::atomic<std::uint64_t> ticks_skipped_{0};
   std::atomic<std::uint64_t> step_failures_{0};
   std::atomic<std::uint64_t> frame_bytes_{0};
   std::atomic<std::int64_t> frames_in_flight_{0};

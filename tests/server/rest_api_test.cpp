@@ -199,7 +199,8 @@ TEST_F(RestApi, Metrics) {
   for (const char* name :
        {"tumble_step_seconds_bucket{le=\"+Inf\"}", "tumble_step_seconds_count",
         "tumble_real_time_factor", "tumble_bodies_awake", "tumble_bodies_frozen",
-        "tumble_viewers", "tumble_frames_sent_total", "tumble_frames_dropped_total"})
+        "tumble_viewers", "tumble_frames_sent_total", "tumble_frames_dropped_total",
+        "tumble_frame_ticks_skipped_total"})
     EXPECT_NE(r.body.find(name), std::string::npos) << name;
 }
 
