@@ -32,30 +32,47 @@ void fly_in_island(Body& b, const SolverBody& solved, double dt) {
 void flight(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
   ctx.pool.for_each(s.solver_bodies.size(), kIslandGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k)
-      fly_in_island(ctx.bodies[s.solver_bodies[k]], s.solver.bodies[k], ctx.dt);
+    for (std::size_t k = begin; k < end; ++k) {
+      Body& b = ctx.bodies[s.solver_bodies[k]];
+      fly_in_island(b, s.solver.bodies[k], ctx.dt);
+      note_moved(ctx.broad, s.solver_bodies[k], b.s);
+    }
   });
   // A lone body flies with the scene's integrator, its floor impacts found at their time of
-  // impact and resting contact handled exactly (floor_contact.cpp).
-  // Each lone body's start state is kept for finalize here, where it is read anyway.
-  BodyState* before = s.before.data() + s.solver_bodies.size();
+  // impact and resting contact handled exactly (floor_contact.cpp). Finalize's rule and the
+  // sleep rule (an island of one) follow at once, and the next broad phase's check of its
+  // quiet bound, while the body is in cache: apart, each streamed the awake bodies' 288-byte
+  // records again (Box2D v3's finalize pass likewise checks each body's sleep velocity and its
+  // enlarged box in the pass that integrates its position).
   // Each lone body's turn is kept for the next step in the slot of its place in the list (a
   // slot that changes body is recomputed: the cache is keyed by the turn's angle alone), so
   // the memory follows the bodies in flight, 104 bytes each, not the world's size.
   if (s.spins.size() < s.lone_bodies.size()) s.spins.resize(s.lone_bodies.size());
+  const bool renormalize = renormalize_after(ctx.step_index);
+  std::atomic<std::uint32_t> asleep = 0;
   ctx.pool.for_each(s.lone_bodies.size(), kLoneGrain, [&](std::size_t begin, std::size_t end) {
-    std::uint32_t impacts = 0, iterations = 0;
+    std::uint32_t impacts = 0, iterations = 0, frozen = 0, slept = 0;
     for (std::size_t k = begin; k < end; ++k) {
-      Body& b = ctx.bodies[s.lone_bodies[k]];
-      before[k] = b.s;
+      const std::uint32_t id = s.lone_bodies[k];
+      Body& b = ctx.bodies[id];
+      const BodyState before = b.s;
       const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt, &s.spins[k]);
       impacts += static_cast<std::uint32_t>(r.impacts);
       iterations += static_cast<std::uint32_t>(r.toi_iterations);
       b.in_contact = r.touched;
+      if (!finalize_body(b, before, renormalize)) {
+        ++frozen;
+        continue;
+      }
+      slept += settle_lone_body(b, id, ctx.cache, ctx.dt, ctx.world) ? 1 : 0;
+      note_moved(ctx.broad, id, b.s);
     }
     std::atomic_ref(ctx.stats.impacts).fetch_add(impacts, std::memory_order_relaxed);
     std::atomic_ref(ctx.stats.toi_iterations).fetch_add(iterations, std::memory_order_relaxed);
+    if (frozen) std::atomic_ref(ctx.stats.newly_frozen).fetch_add(frozen);
+    if (slept) asleep.fetch_add(slept, std::memory_order_relaxed);
   });
+  ctx.cache.activity_epoch += asleep.load();  // finalize moves it for the frozen ones
 }
 
 }  // namespace tumble

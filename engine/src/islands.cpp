@@ -79,17 +79,14 @@ void islands(StepContext& ctx) {
           (s.links.empty() || s.island.island_of[i] < 0))
         s.lone_bodies.push_back(i);
   }
-  s.stepped = s.solver_bodies;
-  s.stepped.insert(s.stepped.end(), s.lone_bodies.begin(), s.lone_bodies.end());
-  // The island bodies' start states; flight keeps the lone bodies' as it reads them (one pass
-  // over their states instead of two).
-  s.before.resize(s.stepped.size());
+  // The island bodies' start states, for finalize (flight keeps a lone body's as it reads it).
+  s.before.resize(s.solver_bodies.size());
   ctx.pool.for_each(s.solver_bodies.size(), 1024, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) s.before[k] = ctx.bodies[s.stepped[k]].s;
+    for (std::size_t k = begin; k < end; ++k) s.before[k] = ctx.bodies[s.solver_bodies[k]].s;
   });
   ctx.stats.islands = static_cast<std::uint32_t>(s.island.count());
   ctx.stats.solver_bodies = static_cast<std::uint32_t>(s.solver_bodies.size());
-  ctx.stats.awake = static_cast<std::uint32_t>(s.stepped.size());
+  ctx.stats.awake = static_cast<std::uint32_t>(s.solver_bodies.size() + s.lone_bodies.size());
 }
 
 }  // namespace tumble

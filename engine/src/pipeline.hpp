@@ -10,7 +10,9 @@
 ///   contact_solve → contact_solve.cpp  impacts, friction, non-penetration of the islands (the
 ///                                     solver: contact_solver.cpp, contact_rows.cpp,
 ///                                     shock_propagation.cpp)
-///   flight        → flight.cpp        every awake body moved over dt
+///   flight        → flight.cpp        every awake body moved over dt; a lone body's finalize
+///                                     and sleep rules applied at once (finalize_body,
+///                                     settle_lone_body), while it is in cache
 ///   finalize      → finalize.cpp      finiteness (freeze) and re-orthonormalisation
 ///   update_sleep  → sleep.cpp         one rule: an island still for long enough sleeps
 ///
@@ -77,6 +79,9 @@ struct BroadPhaseCache {
   std::size_t swept_pairs = 0;           ///< fat_pairs' size after the last sweep.
   bool fat_complete = true;              ///< fat_pairs holds every pair (within the budget).
   std::vector<QuietBound> quiet;         ///< When an unpaired body is still inside its fat box.
+  /// Body i is within quiet[i]: kept for every awake body whenever its state or its bound
+  /// changes (note_moved), so the next broad phase reads a byte, not the body.
+  std::vector<std::uint8_t> inside;
   std::vector<std::uint8_t> stale;       ///< boxes[i] not recomputed this step (quiet body).
   std::vector<std::uint8_t> paired;      ///< Body is in fat_pairs.
   std::vector<std::uint32_t> refit;      ///< Bodies whose fat box changed since the last sweep.
@@ -111,8 +116,7 @@ struct StepScratch {
   IslandScratch island;                 ///< Union–find and island lists.
   std::vector<std::uint32_t> solver_bodies;  ///< Bodies in islands of two or more, ascending.
   std::vector<std::uint32_t> lone_bodies;    ///< Awake bodies touching no other body.
-  std::vector<std::uint32_t> stepped;        ///< solver_bodies then lone_bodies.
-  std::vector<BodyState> before;             ///< State of stepped[k] at the step start.
+  std::vector<BodyState> before;             ///< State of solver_bodies[k] at the step start.
   SolverScratch solver;                      ///< The contact solver's per-body data.
   std::vector<SpinCache> spins;              ///< The turn of lone_bodies[k] in flight (a cube's).
 };
@@ -142,19 +146,37 @@ void broad_phase(StepContext& ctx);
 void narrow_phase(StepContext& ctx);
 /// Stage: islands of touching bodies (scratch.solver_bodies); every other awake body is an
 /// island of one (scratch.lone_bodies); the island bodies' start states kept for finalize
-/// (scratch.before; flight keeps the lone bodies').
+/// (scratch.before).
 void islands(StepContext& ctx);
 /// Stage: impulses of the islands' contacts; leaves the islands' momenta at the end of the
 /// step and their split-impulse pseudo velocities in scratch.solver.
 void contact_solve(StepContext& ctx);
 /// Stage: moves every awake body over dt: a lone body with the scene's integrator and its
-/// floor impacts at their time of impact, an island body with its solved velocities.
+/// floor impacts at their time of impact, then finalize_body and settle_lone_body on it; an
+/// island body with its solved velocities.
 void flight(StepContext& ctx);
-/// Stage: freezes bodies that went non-finite (restoring their start state) and
-/// re-orthonormalises R every kGramSchmidtInterval steps.
+/// Stage: finalize_body on every island body.
 void finalize(StepContext& ctx);
-/// Stage: one sleep rule for every island (a lone body is an island of one).
+/// Stage: one sleep rule for every island (a lone body took it in flight: settle_lone_body).
 void update_sleep(StepContext& ctx);
+
+/// Whether the step after `step_index` steps re-orthonormalises R (every kGramSchmidtInterval).
+bool renormalize_after(std::uint64_t step_index);
+/// Finalize's rule for one stepped body: non-finite, it gets `before` back and is frozen
+/// (returns false; the caller counts it in StepStats::newly_frozen); else its R is
+/// re-orthonormalised when `renormalize`. Touches only b.
+bool finalize_body(Body& b, const BodyState& before, bool renormalize);
+/// The sleep rule for lone body `id` (an island of one) after its finalize: its still time,
+/// and asleep at rest once still for long enough (returns true; the caller moves
+/// ContactCache::activity_epoch). Touches only b and cache's slots of id: safe across threads
+/// for distinct bodies.
+bool settle_lone_body(Body& b, std::uint32_t id, ContactCache& cache, double dt,
+                      const WorldDef& world);
+
+/// Body i's state changed (flight, an impulse): whether it is still within its quiet bound,
+/// for the next broad phase (BroadPhaseCache::inside). Writes only slot i: safe across threads
+/// for distinct bodies.
+void note_moved(BroadPhaseCache& k, std::uint32_t i, const BodyState& s);
 
 /// Pairs of bodies whose boxes overlap as placed (stops counting just past pair_budget).
 std::size_t initial_pairs(std::span<const Body> bodies, const Vec3& gravity);

@@ -55,15 +55,18 @@ bool ready_to_sleep(const Body& b) {
   return b.activity == Activity::awake && b.still_time >= kSleepTime;
 }
 
-/// Puts the island `members` to sleep as one ring.
+/// Body b asleep, exactly at rest.
+void rest(Body& b) {
+  b.activity = Activity::asleep;
+  b.s.P.setZero();
+  b.s.L.setZero();
+}
+
+/// Puts the island `members` to sleep as one ring; the caller moves the activity epoch.
 void fall_asleep(ContactCache& cache, std::span<Body> bodies,
                  std::span<const std::uint32_t> members) {
-  ++cache.activity_epoch;
   for (std::size_t n = 0; n < members.size(); ++n) {
-    Body& b = bodies[members[n]];
-    b.activity = Activity::asleep;
-    b.s.P.setZero();
-    b.s.L.setZero();
+    rest(bodies[members[n]]);
     cache.sleep_next[members[n]] = members[(n + 1) % members.size()];
   }
 }
@@ -94,18 +97,28 @@ void wake_island(ContactCache& cache, std::span<Body> bodies, std::uint32_t id) 
   } while (i != id);
 }
 
+bool settle_lone_body(Body& b, std::uint32_t id, ContactCache& cache, double dt,
+                      const WorldDef& world) {
+  update_still_time(b, cache.anchors[id], dt, world);
+  if (!ready_to_sleep(b)) return false;
+  rest(b);
+  cache.sleep_next[id] = id;  // a ring of one
+  return true;
+}
+
+// Lone bodies took the rule in flight (settle_lone_body); the islands take it here.
 void update_sleep(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
-  for (std::uint32_t id : s.stepped)
+  for (std::uint32_t id : s.solver_bodies)
     update_still_time(ctx.bodies[id], ctx.cache.anchors[id], ctx.dt, ctx.world);
   for (std::size_t k = 0; k < s.island.count(); ++k) {
     const std::span<const std::uint32_t> members = s.island.island(k);
     bool still = true;
     for (std::uint32_t id : members) still = still && ready_to_sleep(ctx.bodies[id]);
-    if (still) fall_asleep(ctx.cache, ctx.bodies, members);
+    if (!still) continue;
+    fall_asleep(ctx.cache, ctx.bodies, members);
+    ++ctx.cache.activity_epoch;
   }
-  for (std::uint32_t id : s.lone_bodies)
-    if (ready_to_sleep(ctx.bodies[id])) fall_asleep(ctx.cache, ctx.bodies, {&id, 1});
 }
 
 }  // namespace tumble

@@ -145,6 +145,7 @@ void World::apply_impulse(BodyId id, const Vec3& impulse, const Vec3& point) {
   b.s.P += impulse;
   b.s.L += (point - b.s.x).cross(impulse);
   wake_island(*cache_, bodies_, id);
+  note_moved(*broad_, id, b.s);
 }
 
 void World::apply_impulse(BodyId id, const Vec3& impulse) {
