@@ -34,6 +34,13 @@ struct QuietBound {
   double l2 = -1.0;  ///< Largest |L|², (kg·m²/s)².
 };
 
+/// Whether a body in state s is within its quiet bound q (false when q is none).
+inline bool within(const QuietBound& q, const BodyState& s) {
+  if (!(s.P.squaredNorm() <= q.p2 && s.L.squaredNorm() <= q.l2)) return false;
+  const Vec3& x = s.x;
+  return (q.core.lo.array() <= x.array()).all() && (x.array() <= q.core.hi.array()).all();
+}
+
 /// Whether two boxes overlap (touching counts).
 inline bool overlaps(const Aabb& a, const Aabb& b) {
   return a.lo.x() <= b.hi.x() && a.lo.y() <= b.hi.y() && a.lo.z() <= b.hi.z() &&

@@ -176,7 +176,9 @@ bool settle_lone_body(Body& b, std::uint32_t id, ContactCache& cache, double dt,
 /// Body i's state changed (flight, an impulse): whether it is still within its quiet bound,
 /// for the next broad phase (BroadPhaseCache::inside). Writes only slot i: safe across threads
 /// for distinct bodies.
-void note_moved(BroadPhaseCache& k, std::uint32_t i, const BodyState& s);
+inline void note_moved(BroadPhaseCache& k, std::uint32_t i, const BodyState& s) {
+  if (i < k.inside.size()) k.inside[i] = within(k.quiet[i], s);
+}
 
 /// Pairs of bodies whose boxes overlap as placed (stops counting just past pair_budget).
 std::size_t initial_pairs(std::span<const Body> bodies, const Vec3& gravity);
