@@ -16,13 +16,16 @@ void colour_contacts(std::span<const std::int32_t> a, std::span<const std::int32
                      std::size_t body_count, ContactColours& out) {
   const std::size_t n = a.size();
   out.latest.assign(body_count, 0);
+  out.degree.assign(body_count, 0);
   out.colour.resize(n);
+  out.rank_a.resize(n);
+  out.rank_b.resize(n);
   std::uint32_t colours = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t c =
         std::max(a[i] >= 0 ? out.latest[a[i]] : 0u, b[i] >= 0 ? out.latest[b[i]] : 0u);
-    if (a[i] >= 0) out.latest[a[i]] = c + 1;
-    if (b[i] >= 0) out.latest[b[i]] = c + 1;
+    if (a[i] >= 0) out.latest[a[i]] = c + 1, out.rank_a[i] = out.degree[a[i]]++;
+    if (b[i] >= 0) out.latest[b[i]] = c + 1, out.rank_b[i] = out.degree[b[i]]++;
     out.colour[i] = c;
     colours = std::max(colours, c + 1);
   }

@@ -15,6 +15,10 @@ namespace tumble {
 struct ContactColours {
   std::vector<std::uint32_t> order;   ///< Contact indices, colour by colour.
   std::vector<std::uint32_t> offset;  ///< Start of each colour in `order`, plus the end.
+  std::vector<std::uint32_t> rank_a;  ///< Contacts of each contact's body a before it.
+  std::vector<std::uint32_t> rank_b;  ///< Contacts of each contact's body b before it.
+  std::vector<std::uint32_t> degree;  ///< Contacts of each body.
+  std::vector<std::uint32_t> turns;   ///< Scratch of a sweep: contacts each body has taken.
   std::vector<std::uint32_t> latest;  ///< Scratch: one past each body's latest colour.
   std::vector<std::uint32_t> colour;  ///< Scratch: colour of each contact.
   /// Number of colours.
@@ -27,7 +31,8 @@ struct ContactColours {
 
 /// Colours contacts between bodies `a[i]` and `b[i]` (indices below body_count, or −1 for
 /// the static floor, which never constrains a colour): each contact's colour is one more than
-/// the latest colour of its bodies so far. Deterministic: depends only on the contact order.
+/// the latest colour of its bodies so far; each contact's rank among its bodies' contacts and
+/// each body's degree with them. Deterministic: depends only on the contact order.
 void colour_contacts(std::span<const std::int32_t> a, std::span<const std::int32_t> b,
                      std::size_t body_count, ContactColours& out);
 

@@ -24,6 +24,14 @@ void cpu_relax() {
 
 }  // namespace
 
+void wait_turn(std::uint32_t& counter, std::uint32_t turn) {
+  const std::atomic_ref<std::uint32_t> c(counter);
+  for (int spins = 0; c.load(std::memory_order_acquire) != turn; ++spins) {
+    if (spins < kSpinRounds) cpu_relax();
+    else std::this_thread::yield();
+  }
+}
+
 unsigned hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
 WorkerPool::WorkerPool(unsigned threads) {
@@ -121,6 +129,7 @@ void WorkerPool::work_phases(std::size_t slot) {
       ph.done.fetch_add(1, std::memory_order_release);
     }
     // Every chunk of phase p is taken; wait until they are done (their writes visible).
+    if (!phase_barrier_) continue;
     for (int spins = 0; ph.done.load(std::memory_order_acquire) < ph.chunks; ++spins) {
       if (spins < kSpinRounds) cpu_relax();
       else std::this_thread::yield();

@@ -16,6 +16,15 @@
 
 namespace tumble {
 
+/// Waits until `counter` (read atomically, acquire) equals `turn`: spins, then yields. With
+/// pass_turn, orders the items of a for_each_phase job run without barriers.
+void wait_turn(std::uint32_t& counter, std::uint32_t turn);
+/// Adds one to `counter` (release); only the thread whose turn it was may call it.
+inline void pass_turn(std::uint32_t& counter) {
+  std::atomic_ref<std::uint32_t> c(counter);
+  c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+}
+
 /// Worker threads that spin briefly between jobs (a step submits a few hundred small jobs in
 /// a row) and sleep on a futex otherwise. A worker that comes late finds the job done and
 /// skips it: the caller never waits for a thread that has not started, so a busy machine
@@ -48,9 +57,13 @@ class WorkerPool {
   /// thread waits between phases on a counter (a fraction of a microsecond) where a job per
   /// phase cost the caller a publication, a close and a thread's idle chunk each. `size` is
   /// called once per phase, on the caller. Runs inline when the pool has no workers or the
-  /// phases average under two chunks. Allocates only when `phases` grows.
+  /// phases average under two chunks. Allocates only when `phases` grows. With `barrier`
+  /// false a thread that finds no chunk left in a phase moves on at once: fn then orders
+  /// its items itself (the contact sweep waits for each body's turn: wait_turn).
   template <typename Size, typename Fn>
-  void for_each_phase(std::size_t phases, std::size_t grain, Size&& size, Fn&& fn) {
+  void for_each_phase(std::size_t phases, std::size_t grain, Size&& size, Fn&& fn,
+                      bool barrier = true) {
+    phase_barrier_ = barrier;
     if (workers_.empty()) {
       for (std::size_t p = 0; p < phases; ++p) fn(p, std::size_t{0}, static_cast<std::size_t>(size(p)));
       return;
@@ -115,6 +128,7 @@ class WorkerPool {
   std::unique_ptr<Phase[]> phases_;  // the phases of the current for_each_phase job
   std::size_t phase_capacity_ = 0;
   std::size_t phase_count_ = 0;
+  bool phase_barrier_ = true;  // a phase starts once the one before is done
   PhaseThunk phase_thunk_ = nullptr;
   void* phase_fn_ = nullptr;
   std::vector<std::thread> workers_;
