@@ -316,14 +316,16 @@ bool pair_escaped(BroadPhaseCache& k, std::size_t escaped, std::size_t n) {
 void filter_pairs(StepContext& ctx) {
   constexpr std::size_t kGrain = 2048;  // pairs per range: ~10 ns each
   BroadPhaseCache& k = ctx.broad;
-  auto keep = [&k](std::size_t begin, std::size_t end, std::vector<BodyPair>& out) {
-    for (std::size_t j = begin; j < end; ++j) {
-      const BodyPair& p = k.fat_pairs[j];
-      if ((k.active[p.first] || k.active[p.second]) && overlaps(k.boxes[p.first], k.boxes[p.second]))
+  // Local views: through `k` every push_back would reload the lists it might have changed.
+  const std::span<const BodyPair> pairs(k.fat_pairs);
+  const std::uint8_t* active = k.active.data();
+  const Aabb* boxes = k.boxes.data();
+  auto keep = [&](std::size_t begin, std::size_t end, std::vector<BodyPair>& out) {
+    for (const BodyPair& p : pairs.subspan(begin, end - begin))
+      if ((active[p.first] || active[p.second]) && overlaps(boxes[p.first], boxes[p.second]))
         out.push_back(p);
-    }
   };
-  const std::size_t n = k.fat_pairs.size();
+  const std::size_t n = pairs.size();
   const std::size_t ranges = std::min<std::size_t>(4 * ctx.pool.size(), n / kGrain);
   if (ranges < 2) return keep(0, n, ctx.scratch.pairs);
   std::vector<std::vector<BodyPair>>& parts = k.sweep.range_pairs;
