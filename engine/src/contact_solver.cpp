@@ -342,12 +342,16 @@ template <typename Fn>
 void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool, Fn&& fn,
            int passes = 1) {
   constexpr std::size_t kGrain = 8;  // contacts per chunk: 0.1–0.5 µs each
-  if (pool.size() == 1) {  // contact order: what the colours replay, without their cost
+  // Colours of under kShared contacts on average (`pyramid`: ~10) leave each thread a chunk
+  // or two per colour, whose waits cost more than the second thread saves.
+  constexpr std::size_t kShared = 24;
+  ContactColours& colours = scratch.colours;
+  if (pool.size() == 1 || contacts.size() < kShared * colours.count()) {
+    // Contact order: what the colours replay, without their cost.
     for (int pass = 0; pass < passes; ++pass)
       for (std::size_t i = 0; i < contacts.size(); ++i) fn(contacts[i], i);
     return;
   }
-  ContactColours& colours = scratch.colours;
   const std::size_t count = colours.count();
   colours.turns.assign(colours.degree.size(), 0);
   pool.for_each_phase(
