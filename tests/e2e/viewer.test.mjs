@@ -125,10 +125,9 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
       assert.ok(paused.count > 400, `box visible while paused (${paused.count} px)`);
       // The orange pixels are where the page's camera puts the body: their centre within three
       // quarters of the box's size (√ of its pixel count: ~97 px here) of its centre's
-      // projection, at least 40 px. Faces
-      // in shadow (red below 60) do not count, so the centre of the lit ones sits off the
-      // body's centre by up to about half the box, depending on where it paused (a clean-clone
-      // CI run measured 43 px).
+      // projection, at least 40 px. Faces in shadow (red below 60) do not count, so the centre
+      // of the lit ones sits off the body's centre by up to about half the box, depending on
+      // where it paused (a clean-clone CI run measured 43 px).
       const centre = await page.evaluate(() => window.tumble.bodyScreenPosition(0));
       const off = Math.hypot(centre.x - paused.x, centre.y - paused.y);
       const limit = Math.max(40, 0.75 * Math.sqrt(paused.count));
