@@ -8,7 +8,7 @@ namespace tumble {
 namespace {
 
 constexpr std::size_t kIslandGrain = 256;  // bodies per chunk: ~20 ns each
-constexpr std::size_t kLoneGrain = 64;     // bodies per chunk: 0.1–1 µs each
+constexpr std::size_t kLoneGrain = 16;     // bodies per chunk: 0.1 µs to several each
 
 // An island body's momenta already hold the step's gravity and contact impulses (the contact
 // solve is velocity-level, Box2D's order: integrate velocities, solve, integrate positions), so

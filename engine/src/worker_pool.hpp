@@ -41,6 +41,23 @@ class WorkerPool {
   /// Threads that share a job, the caller included.
   unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
 
+  /// While held (by the submitting thread, around one World::step), idle workers poll for the
+  /// next job up to ~0.2 ms instead of ~25 µs before they sleep: a step's serial stretches
+  /// between jobs outlast the short poll, and each then cost a wake-up. Not nested.
+  class Busy {
+   public:
+    /// Marks `pool` busy until destruction.
+    explicit Busy(WorkerPool& pool) : pool_(pool) {
+      pool_.busy_.store(true, std::memory_order_relaxed);
+    }
+    ~Busy() { pool_.busy_.store(false, std::memory_order_relaxed); }
+    Busy(const Busy&) = delete;
+    Busy& operator=(const Busy&) = delete;
+
+   private:
+    WorkerPool& pool_;
+  };
+
   /// Calls fn(begin, end) over [0, n) in chunks of at least `grain` indices, on this thread
   /// and the workers; returns when every chunk is done. Runs inline when n ≤ grain or the
   /// pool has no workers. Allocates nothing.
@@ -152,6 +169,7 @@ class WorkerPool {
   std::atomic<unsigned> sleepers_{0};        // workers asleep on work_ready_
   std::atomic<bool> caller_waiting_{false};  // the caller asleep on job_left_
   std::atomic<bool> stop_{false};
+  std::atomic<bool> busy_{false};  // a step is under way: poll longer (Busy)
   static constexpr std::uint64_t kClosed = std::uint64_t{1} << 16;
   static constexpr std::uint64_t kInside = kClosed - 1;
   static constexpr std::uint64_t kGeneration = std::uint64_t{1} << 17;

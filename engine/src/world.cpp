@@ -100,6 +100,7 @@ void World::step(double dt) {
   last_ = {};
   StepContext ctx{scene_.world, dt,       steps_, bodies_, *cache_,
                   *broad_,       *scratch_, last_,  *pool_};
+  const WorkerPool::Busy busy(*pool_);  // workers poll through the step's serial stretches
   for (int round = 0; round < kMaxWakeRounds; ++round) {
     run_stage(Stage::broad_phase, broad_phase, ctx, time_stages_);
     run_stage(Stage::narrow_phase, narrow_phase, ctx, time_stages_);
