@@ -103,13 +103,14 @@ struct StepScratch {
   std::vector<BodyPair> pairs;          ///< Broad-phase pairs (sorted).
   std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
   std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.
-  std::vector<BoxManifold> manifolds;   ///< Manifold of each pair (count 0: no contact).
+  std::vector<BoxManifold> manifolds;   ///< Manifold of each pair with points (slot ≥ 0).
   std::vector<BodyVelocity> velocities; ///< Awake bodies' velocities (narrow phase, by body).
   std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
   std::vector<std::int32_t> slot;       ///< Position of each pair's (body's) contact, or −1.
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<std::uint8_t> marked;     ///< Scratch of `linked`: body is in a box–box contact.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
+  std::vector<std::uint8_t> wakes;      ///< 1 where a link's body was asleep when found.
   std::vector<double> speed;            ///< Point-speed bound of each linked body, m/s.
   std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
   int woken = 0;                        ///< Sleeping bodies the narrow phase woke.
