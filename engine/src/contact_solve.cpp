@@ -28,9 +28,10 @@ void warm_start(StepContext& ctx) {
 }
 
 /// Keeps this step's contacts (with their impulses) for the next step's warm start, their keys
-/// read on the pool (a contact is ~1 KB: one cache miss each on one thread). The narrow phase lists the floor's contacts (body a = kStaticBody, the largest key) in body
-/// order and then the box–box ones in pair order: two sorted runs, put in order by a rotation
-/// (a sort of the keys was 1 % of `pile`, on one thread); a sort if ever they are not.
+/// read on the pool (a contact is ~1 KB: one cache miss each on one thread). The narrow phase
+/// lists the floor's contacts (body a = kStaticBody, the largest key) in body order and then
+/// the box–box ones in pair order: two sorted runs, put in order by a rotation (a sort of the
+/// keys was 1 % of `pile`, on one thread); a sort if ever they are not.
 void keep_for_warm_start(StepContext& ctx) {
   ContactCache& cache = ctx.cache;
   std::swap(cache.previous, ctx.scratch.contacts);

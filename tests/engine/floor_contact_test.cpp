@@ -1,8 +1,10 @@
-// Impacts with the floor: apex heights, energy, flat landings, rest, sleep, friction.
+// Impacts with the floor: apex heights, energy, flat landings, rest, sleep, friction, tipping.
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "floor_contact.hpp"
+#include "tumble_reference/tipping_box.hpp"
 #include "world_fixture.hpp"
 
 namespace tumble {
@@ -211,6 +213,48 @@ TEST(Glide, FaceDownBoxOnFrictionlessFloorGlidesAndSpinsFreely) {
     const Mat3 turned = Eigen::AngleAxisd(3.0 * t, Vec3::UnitY()).toRotationMatrix();
     EXPECT_LT(rotation_angle_between(turned, s.R), 1e-12) << size.transpose();
     EXPECT_EQ(world.body(0).activity, Activity::awake);
+  }
+}
+
+// A unit cube on one edge of a floor with μ = 1, 0.05 rad past balance, tips over as a
+// pendulum about that edge: θ̈ = 1.5 g d sin θ with d = √2/2 (tumble_reference/tipping_box.hpp,
+// Boost.Odeint). The resting-contact step moves the body with its end-of-step velocities
+// (first order): it meets each angle early by about half a step. Measured at 0.2, 0.5 and
+// 0.7 rad: 8.1, 7.7 and 7.3 ms early at dt 1/60; 2.05, 1.94 and 1.83 ms at 1/240 (0.49–0.44 dt);
+// the pivot edge moves at most 0.68 mm and 0.17 mm. A pivot that slid, a cube that fell
+// asleep balanced, or a step that lost the torque would fall far outside these bounds.
+TEST(Friction, CubeTipsOverAnEdgeAsAPendulum) {
+  const double d = std::sqrt(0.5), theta0 = 0.05;
+  const std::vector<double> angles{0.2, 0.5, 0.7};
+  const std::vector<double> reference =
+      tumble_reference::tipping_times(1.5 * kG * d, theta0, angles);
+  for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+    Scene scene;
+    scene.world.floor = Floor{0.0, 0.0, 1.0};
+    scene.world.dt = dt;
+    BodyDef b;
+    b.orientation = Quat(Eigen::AngleAxisd(0.25 * std::numbers::pi + theta0, Vec3::UnitZ()));
+    b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};  // the edge on the floor
+    scene.bodies.push_back(b);
+    World world(scene);
+    double t_prev = 0.0, theta_prev = theta0, pivot_moved = 0.0;
+    std::size_t next = 0;
+    for (int i = 1; i <= static_cast<int>(2.0 / dt) && next < angles.size(); ++i) {
+      world.step();
+      const BodyState& s = world.body(0).s;
+      const double theta = std::atan2(s.R(1, 0), s.R(0, 0)) - 0.25 * std::numbers::pi;
+      const Vec3 pivot = s.x + s.R * Vec3(-0.5, -0.5, 0.5);  // a corner of the pivot edge
+      pivot_moved = std::max(pivot_moved, std::hypot(pivot.x(), pivot.y()));
+      for (; next < angles.size() && theta >= angles[next]; ++next) {
+        const double f = (angles[next] - theta_prev) / (theta - theta_prev);
+        const double t = t_prev + f * (i * dt - t_prev);  // the crossing, linearly interpolated
+        EXPECT_NEAR(t, reference[next], 0.55 * dt) << "dt = " << dt << ", θ = " << angles[next];
+      }
+      t_prev = i * dt;
+      theta_prev = theta;
+    }
+    EXPECT_EQ(next, angles.size()) << "dt = " << dt << ": the cube did not tip over";
+    EXPECT_LT(pivot_moved, 0.05 * dt) << "dt = " << dt;
   }
 }
 
