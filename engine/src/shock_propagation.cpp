@@ -39,12 +39,14 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   const Vec3 up = -gravity / g;
   std::vector<std::pair<double, std::uint32_t>>& order = order_;
   order.clear();
-  for (std::size_t i = 0; i < contacts.size(); ++i)
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
     // A contact whose normal is nearly horizontal supports nothing and is left to the
-    // iterations.
-    if (std::abs(contacts[i].normal.dot(up)) >= kSupportCosine)
-      order.emplace_back(up.dot(bodies_[upper_of(contacts[i], up)].s.x),
-                         static_cast<std::uint32_t>(i));
+    // iterations, as is one that would hold the floor up (gravity pointing away from it): the
+    // floor does not move, and the body under it has no support to be pushed from.
+    const std::uint32_t upper = upper_of(contacts[i], up);
+    if (std::abs(contacts[i].normal.dot(up)) >= kSupportCosine && upper != kStaticBody)
+      order.emplace_back(up.dot(bodies_[upper].s.x), static_cast<std::uint32_t>(i));
+  }
   // By the height of the supported body, its contacts together (in contact order).
   std::sort(order.begin(), order.end(), [&](const auto& p, const auto& q) {
     if (p.first != q.first) return p.first < q.first;
