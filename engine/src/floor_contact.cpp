@@ -465,6 +465,12 @@ bool at_rest_on_face(const BodyState& s, const BodyConstants& c, double floor_he
   return touching_vertices(s, c, floor_height + kContactBand).count >= 3;
 }
 
+bool touches_floor_on_edge_or_corner(const BodyState& s, const BodyConstants& c,
+                                     double floor_height) {
+  const int count = touching_vertices(s, c, floor_height + kContactBand).count;
+  return count > 0 && count < 3;
+}
+
 namespace {
 
 /// advance_with_floor for a body that may meet the floor within the step; `flown`, when not

@@ -32,6 +32,12 @@ bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_heig
 /// resting contact's band (1e-6 m) of the floor: how a landed box comes to rest on a face.
 bool at_rest_on_face(const BodyState& s, const BodyConstants& c, double floor_height);
 
+/// True when the body's lowest points on the floor are one or two vertices (a corner or an
+/// edge within the resting contact's 1e-6 m band), not a face: under gravity into the floor a
+/// box so supported balances at best unstably.
+bool touches_floor_on_edge_or_corner(const BodyState& s, const BodyConstants& c,
+                                     double floor_height);
+
 /// Advances one awake body by dt: flight with the world's integrator, impacts located by
 /// the world's TOI method and answered with impulses, resting contact without sinking.
 /// `spin` (may be null) keeps a cube's turn between steps (integrators.hpp).

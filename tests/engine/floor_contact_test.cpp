@@ -258,5 +258,49 @@ TEST(Friction, CubeTipsOverAnEdgeAsAPendulum) {
   }
 }
 
+// A cube a little past balance on an edge is an inverted pendulum: the offset grows as e^(λt)
+// (λ = 3.2 /s), slowly at first, and a speed or reach test alone would put it to sleep there,
+// frozen past balance (0.0028 rad past it, after 0.5 s, before sleep.cpp's rule for bodies
+// on an edge or a corner). It must stay awake, fall at the pendulum's time (the first-order
+// resting step meets 0.5 rad 0.44–0.46 dt early, as from 0.05 rad above) and sleep only once
+// it lies on a face, at rest to the resting contact's 1e-6 m.
+TEST(Sleep, ACubeJustPastBalanceOnAnEdgeFallsOntoAFaceAndOnlyThenSleeps) {
+  const double d = std::sqrt(0.5), quarter = 0.5 * std::numbers::pi;
+  for (const double theta0 : {1e-3, -1e-3, 1e-5}) {
+    const double fall =
+        tumble_reference::tipping_times(1.5 * kG * d, std::abs(theta0), {0.5}).front();
+    for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+      Scene scene;
+      scene.world.floor = Floor{0.0, 0.0, 1.0};
+      scene.world.dt = dt;
+      BodyDef b;
+      b.orientation = Quat(Eigen::AngleAxisd(0.25 * std::numbers::pi + theta0, Vec3::UnitZ()));
+      b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};
+      scene.bodies.push_back(b);
+      World world(scene);
+      double t_prev = 0.0, theta_prev = std::abs(theta0), crossed = -1.0;
+      for (int i = 1; i <= static_cast<int>((fall + 1.0) / dt); ++i) {
+        world.step();
+        const BodyState& s = world.body(0).s;
+        const double theta = std::abs(std::atan2(s.R(1, 0), s.R(0, 0)) - 0.25 * std::numbers::pi);
+        if (crossed < 0.0 && theta >= 0.5)
+          crossed = t_prev + (0.5 - theta_prev) / (theta - theta_prev) * (i * dt - t_prev);
+        if (crossed < 0.0)
+          ASSERT_EQ(world.awake_count(), 1u) << "θ0 = " << theta0 << ", dt = " << dt
+                                             << ": asleep at " << i * dt << " s, " << theta
+                                             << " rad from balance";
+        t_prev = i * dt;
+        theta_prev = theta;
+      }
+      EXPECT_NEAR(crossed, fall, 0.55 * dt) << "θ0 = " << theta0 << ", dt = " << dt;
+      const BodyState& s = world.body(0).s;
+      EXPECT_EQ(world.awake_count(), 0u) << "θ0 = " << theta0 << ", dt = " << dt;
+      EXPECT_NEAR(s.x.y(), 0.5, 1e-6) << "θ0 = " << theta0 << ", dt = " << dt;
+      const double face = std::atan2(s.R(1, 0), s.R(0, 0));
+      EXPECT_NEAR(face, quarter * std::round(face / quarter), 1e-6) << "θ0 = " << theta0;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tumble
