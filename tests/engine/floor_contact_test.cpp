@@ -216,6 +216,20 @@ TEST(Glide, FaceDownBoxOnFrictionlessFloorGlidesAndSpinsFreely) {
   }
 }
 
+// A unit cube standing on one edge (along z, through the origin) of a floor with μ = 1,
+// turned theta0 (rad) past balance.
+Scene cube_on_edge(double theta0, double dt) {
+  const double d = std::sqrt(0.5);  // centre to edge, m
+  Scene scene;
+  scene.world.floor = Floor{0.0, 0.0, 1.0};
+  scene.world.dt = dt;
+  BodyDef b;
+  b.orientation = Quat(Eigen::AngleAxisd(0.25 * std::numbers::pi + theta0, Vec3::UnitZ()));
+  b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};
+  scene.bodies.push_back(b);
+  return scene;
+}
+
 // A unit cube on one edge of a floor with μ = 1, 0.05 rad past balance, tips over as a
 // pendulum about that edge: θ̈ = 1.5 g d sin θ with d = √2/2 (tumble_reference/tipping_box.hpp,
 // Boost.Odeint). The resting-contact step moves the body with its end-of-step velocities
@@ -229,14 +243,7 @@ TEST(Friction, CubeTipsOverAnEdgeAsAPendulum) {
   const std::vector<double> reference =
       tumble_reference::tipping_times(1.5 * kG * d, theta0, angles);
   for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
-    Scene scene;
-    scene.world.floor = Floor{0.0, 0.0, 1.0};
-    scene.world.dt = dt;
-    BodyDef b;
-    b.orientation = Quat(Eigen::AngleAxisd(0.25 * std::numbers::pi + theta0, Vec3::UnitZ()));
-    b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};  // the edge on the floor
-    scene.bodies.push_back(b);
-    World world(scene);
+    World world(cube_on_edge(theta0, dt));
     double t_prev = 0.0, theta_prev = theta0, pivot_moved = 0.0;
     std::size_t next = 0;
     for (int i = 1; i <= static_cast<int>(2.0 / dt) && next < angles.size(); ++i) {
@@ -270,14 +277,7 @@ TEST(Sleep, ACubeJustPastBalanceOnAnEdgeFallsOntoAFaceAndOnlyThenSleeps) {
     const double fall =
         tumble_reference::tipping_times(1.5 * kG * d, std::abs(theta0), {0.5}).front();
     for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
-      Scene scene;
-      scene.world.floor = Floor{0.0, 0.0, 1.0};
-      scene.world.dt = dt;
-      BodyDef b;
-      b.orientation = Quat(Eigen::AngleAxisd(0.25 * std::numbers::pi + theta0, Vec3::UnitZ()));
-      b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};
-      scene.bodies.push_back(b);
-      World world(scene);
+      World world(cube_on_edge(theta0, dt));
       double t_prev = 0.0, theta_prev = std::abs(theta0), crossed = -1.0;
       for (int i = 1; i <= static_cast<int>((fall + 1.0) / dt); ++i) {
         world.step();
@@ -285,10 +285,11 @@ TEST(Sleep, ACubeJustPastBalanceOnAnEdgeFallsOntoAFaceAndOnlyThenSleeps) {
         const double theta = std::abs(std::atan2(s.R(1, 0), s.R(0, 0)) - 0.25 * std::numbers::pi);
         if (crossed < 0.0 && theta >= 0.5)
           crossed = t_prev + (0.5 - theta_prev) / (theta - theta_prev) * (i * dt - t_prev);
-        if (crossed < 0.0)
+        if (crossed < 0.0) {
           ASSERT_EQ(world.awake_count(), 1u) << "θ0 = " << theta0 << ", dt = " << dt
                                              << ": asleep at " << i * dt << " s, " << theta
                                              << " rad from balance";
+        }
         t_prev = i * dt;
         theta_prev = theta;
       }
