@@ -25,8 +25,10 @@ inline double lowest_vertex_y(const BodyState& s, const BodyConstants& c) {
 double rest_speed(double restitution, const Vec3& gravity, double dt);
 
 /// True when the body is still (P = L = 0) with a whole face on the floor (three or more
-/// vertices within 1e-9 m of it, none below): statically at rest, so it may start asleep.
-bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_height);
+/// vertices within 1e-9 m of it, none below) and the floor holds it there against `gravity`
+/// (m/s²): statically at rest, so it may start asleep.
+bool rests_on_face(const BodyState& s, const BodyConstants& c, double floor_height,
+                   const Vec3& gravity);
 
 /// True when the body is still (P = L = 0 to 1e-12) with three or more vertices within the
 /// resting contact's band (1e-6 m) of the floor: how a landed box comes to rest on a face.

@@ -42,7 +42,8 @@ World::World(Scene scene) : scene_(std::move(scene)) {
     b.s = make_body_state(def, b.c);
     // A body placed still on a face on the floor starts asleep: it costs nothing from the
     // first step instead of after the sleep timer.
-    if (w.floor && rests_on_face(b.s, b.c, w.floor->height)) b.activity = Activity::asleep;
+    if (w.floor && rests_on_face(b.s, b.c, w.floor->height, w.gravity))
+      b.activity = Activity::asleep;
     bodies_.push_back(b);
   }
   // A scene that packs its bodies into one another costs memory and time quadratic in their

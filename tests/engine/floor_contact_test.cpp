@@ -1,5 +1,6 @@
 // Impacts with the floor: apex heights, energy, flat landings, rest, sleep, friction, tipping.
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -216,6 +217,51 @@ TEST(Glide, FaceDownBoxOnFrictionlessFloorGlidesAndSpinsFreely) {
   }
 }
 
+// A unit cube placed still on a face of the floor (μ as given) under `gravity`.
+World cube_on_floor(const Vec3& gravity, double mu) {
+  Scene scene;
+  scene.world.floor = Floor{0.0, 0.0, mu};
+  scene.world.gravity = gravity;
+  BodyDef b;
+  b.position = {0.0, 0.5, 0.0};
+  scene.bodies.push_back(b);
+  return World(scene);
+}
+
+// A box placed still on a face starts asleep only where the floor holds it: gravity into the
+// floor within the friction cone, or none. Under gravity away from the floor it lifts off;
+// tilted past the cone it slides, its centre on the parabola of the constant force
+// (|g_h| − μ |g_y| along the floor, exact where the friction or the frictionless step moves
+// it with the step's mean velocity). Both once started asleep and stayed put for good.
+TEST(Rest, ABoxPlacedOnTheFloorStartsAsleepOnlyWhereTheFloorHoldsIt) {
+  const double t = 2.0, dt = 1.0 / 60.0;
+  struct Case {
+    Vec3 gravity;
+    double mu;
+    double slide;  // expected acceleration along +x, m/s² (NaN: lifts off)
+  };
+  const double lift = std::numeric_limits<double>::quiet_NaN();
+  for (const Case& c : {Case{{0.0, 9.81, 0.0}, 0.5, lift}, Case{{0.0, 0.001, 0.0}, 0.5, lift},
+                        Case{{6.9, -6.9, 0.0}, 0.0, 6.9}, Case{{6.9, -6.9, 0.0}, 0.5, 3.45},
+                        Case{{1.0, -9.81, 0.0}, 0.0, 1.0}, Case{{6.9, -6.9, 0.0}, 2.0, 0.0},
+                        Case{{1.0, -9.81, 0.0}, 0.5, 0.0}, Case{{0.0, 0.0, 0.0}, 0.5, 0.0},
+                        Case{{0.0, -9.81, 0.0}, 0.0, 0.0}}) {
+    World world = cube_on_floor(c.gravity, c.mu);
+    const bool held = c.slide == 0.0;
+    EXPECT_EQ(world.awake_count(), held ? 0u : 1u) << c.gravity.transpose() << ", μ " << c.mu;
+    for (int i = 0; i < static_cast<int>(t / dt + 0.5); ++i) world.step();
+    const Vec3 x = world.body(0).s.x;
+    if (std::isnan(c.slide)) {
+      // The first step leaves resting contact with the end-of-step velocity: ½ g dt² high.
+      const double y = 0.5 + 0.5 * c.gravity.y() * t * t;
+      EXPECT_NEAR(x.y(), y, 0.5 * c.gravity.y() * dt * dt * 1.01) << c.gravity.transpose();
+      continue;
+    }
+    EXPECT_NEAR(x.x(), 0.5 * c.slide * t * t, 1e-9) << c.gravity.transpose() << ", μ " << c.mu;
+    EXPECT_NEAR(x.y(), 0.5, 1e-9) << c.gravity.transpose() << ", μ " << c.mu;
+  }
+}
+
 // A unit cube standing on one edge (along z, through the origin) of a floor with μ = 1,
 // turned theta0 (rad) past balance.
 Scene cube_on_edge(double theta0, double dt) {
@@ -228,6 +274,27 @@ Scene cube_on_edge(double theta0, double dt) {
   b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};
   scene.bodies.push_back(b);
   return scene;
+}
+
+// On a frictionless floor the only horizontal force is gravity's horizontal part: the centre
+// moves along x on the parabola ½ g_x t² whatever the box does, here a cube tipping off an
+// edge onto a face (resting contact, the impact, then gliding). Each step's travel is the
+// step's mean velocity; with the end-of-step velocity it ran ½ g_x dt t ahead.
+TEST(Glide, OnAFrictionlessFloorTheCentreFollowsTheParabolaOfTiltedGravity) {
+  const double dt = 1.0 / 60.0, gx = 1.0;
+  Scene scene = cube_on_edge(0.05, dt);
+  scene.world.floor->friction = 0.0;
+  scene.world.gravity = {gx, -kG, 0.0};
+  World world(scene);
+  const double x0 = world.body(0).s.x.x();
+  double worst = 0.0;
+  for (int i = 1; i <= 120; ++i) {
+    world.step();
+    worst = std::max(worst, std::abs(world.body(0).s.x.x() - x0 - 0.5 * gx * world.time() *
+                                                                      world.time()));
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_NEAR(world.body(0).s.x.y(), 0.5, 1e-6) << "the cube should lie on a face";
 }
 
 // A unit cube on one edge of a floor with μ = 1, 0.05 rad past balance, tips over as a
