@@ -47,8 +47,10 @@ std::string closing_note_contact(const std::map<std::string, std::string>& v) {
     << fmt(number(v, t + "ns_per_body_step")) << " ns per body-step over 2 s ("
     << fmt(number(v, t + "ns_per_body_step_first_0.5s")) << " ns over the first 0.5 s), "
     << fmt(number(v, t + "impacts_per_box")) << " impacts per box, "
-    << fixed(100.0 * number(v, t + "asleep_fraction"), 0) << " % asleep at 2 s, all asleep at "
-    << fmt(number(v, t + "all_asleep_s")) << " s.";
+    << fixed(100.0 * number(v, t + "asleep_fraction"), 0) << " % asleep at 2 s, ";
+  const double all_asleep = number(v, t + "all_asleep_s");
+  s << (std::isnan(all_asleep) ? "not all asleep by the end of the run."
+                               : "all asleep at " + fmt(all_asleep) + " s.");
   const double bullet = number(v, "peers.landing.N10000.bullet.ratio_peer_over_tumble");
   s << " Bullet's time / Tumble's in the `peers` run: " << fmt(bullet)
     << "×, goal ≥ 2×: " << verdict(bullet, 2.0, false) << ".\n";

@@ -25,7 +25,7 @@ double settle(PeerWorld& w, long done, long steps, double dt, double* watched) {
 
 Plan plan(bool quick) {
   if (quick) return {120, 60, 0};  // 0.5 s (most boxes land), first 0.25 s
-  return {480, 120, 480};
+  return {480, 120, 960};  // 2 s timed, then up to 4 s more to see every box asleep
 }
 
 double watched_until(const Plan& p, double dt) {
