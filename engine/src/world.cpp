@@ -40,8 +40,8 @@ World::World(Scene scene) : scene_(std::move(scene)) {
     Body b;
     b.c = make_body_constants(def, e, mu);
     b.s = make_body_state(def, b.c);
-    // A body placed still on a face on the floor starts asleep: it costs nothing from the
-    // first step instead of after the sleep timer.
+    // A body placed still on a face on the floor, where the floor holds it against gravity,
+    // starts asleep: it costs nothing from the first step instead of after the sleep timer.
     if (w.floor && rests_on_face(b.s, b.c, w.floor->height, w.gravity))
       b.activity = Activity::asleep;
     bodies_.push_back(b);
