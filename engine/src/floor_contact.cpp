@@ -408,14 +408,27 @@ void glide_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, doubl
 
 /// Earliest time in [0, h] at which a vertex of `mask` reaches the floor (it is above at 0
 /// and some vertex of the mask is below at h). Returns the non-penetrating end of the final
-/// bracket, so a body is never left inside the floor.
+/// bracket, so a body is never left inside the floor, and sets `at` to the body's state then.
+///
+/// Both searches end on a time they evaluated with the body above the floor (the lower end of
+/// the bracket), so that evaluation's state is kept rather than computed again: the latest
+/// time evaluated above the floor is that end. One trajectory evaluation saved per impact,
+/// the same bits.
 double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef& w,
                       double floor_y, double h, unsigned mask, double height_at_h,
-                      int& evaluations) {
+                      int& evaluations, BodyState& at) {
+  double at_t = 0.0;
+  at = s;
   auto height = [&](double t) {
     ++evaluations;
     const BodyState st = advance(w.integrator, s, c, w.gravity, t);
-    return (mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask)) - floor_y;
+    const double y = (mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask)) - floor_y;
+    if (y >= 0.0 && t > at_t) at_t = t, at = st;
+    return y;
+  };
+  auto state_at = [&](double t) {
+    if (t != at_t) at = advance(w.integrator, s, c, w.gravity, t);  // not met: kept for safety
+    return t;
   };
   if (w.toi == ToiMethod::bisection) {
     // The seed's search: halve the interval, keeping the last time that does not penetrate.
@@ -424,7 +437,7 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
       const double mid = 0.5 * (lo + hi);
       (height(mid) < 0.0 ? hi : lo) = mid;
     }
-    return lo;
+    return state_at(lo);
   }
   // TOMS 748 (Alefeld, Potra & Shi 1995) on the lowest-vertex height along the trajectory:
   // cubic inverse interpolation with bracketing, a few evaluations where bisection takes
@@ -435,7 +448,7 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
   const auto bracket = boost::math::tools::toms748_solve(
       height, 0.0, h, h0, height_at_h, [tol](double a, double b) { return b - a <= tol; },
       max_iter);
-  return bracket.first;
+  return state_at(bracket.first);
 }
 
 unsigned vertices_above(const BodyState& s, const BodyConstants& c, double y) {
@@ -539,9 +552,10 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     }
     const double masked_end =
         mask == 0xFF ? end_height : lowest_masked_y(next, c, mask) - floor_y;
+    BodyState at_impact;
     const double t = time_of_impact(s, c, w, floor_y, remaining, mask, masked_end,
-                                    result.toi_iterations);
-    if (t > 0.0) s = advance(w.integrator, s, c, w.gravity, t);
+                                    result.toi_iterations, at_impact);
+    s = at_impact;
     resolve_floor_impact(s, c, floor_y, c.restitution, c.friction, vrest);
     ++result.impacts;
     result.touched = true;
