@@ -65,10 +65,16 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
 
 }  // namespace
 
-void Solver::prepare(Contact& c, std::size_t n, double dt) {
+void Solver::prepare(Contact& c, std::size_t slot, double dt) {
   SolverBody* a = body(c.a);
   SolverBody* b = body(c.b);
-  ContactRows& block = rows_[n];  // sized by the caller
+  ContactRows& block = rows_[slot];  // sized by the caller
+  block.a = c.a == kStaticBody ? -1 : index_[c.a];
+  block.b = index_[c.b];
+  block.count = c.count;
+  block.mu = c.friction;
+  ContactImpulses& impulses = impulses_[slot];
+  impulses.friction = c.friction_impulse;
   tangents(c.normal, block.dir[1], block.dir[2]);
   block.dir[0] = c.normal;
   const Vec3& normal = c.normal;
@@ -88,6 +94,9 @@ void Solver::prepare(Contact& c, std::size_t n, double dt) {
     const double k = (a ? a->inv_mass + r.ang_a.dot(r.inv_a) : 0.0) + b->inv_mass +
                      r.ang_b.dot(r.inv_b);  // n·K n, 1/kg
     p.normal_mass = 1.0 / k;
+    r.normal_mass = p.normal_mass;
+    r.target = target_of(p, dt);
+    impulses.normal[i] = p.normal_impulse;
   }
   ra0 /= c.count;
   rb0 /= c.count;
@@ -102,6 +111,12 @@ void Solver::prepare(Contact& c, std::size_t n, double dt) {
   }
   if (load > 0.0) prepare_friction(c, block, a, b, ra_load / load, rb_load / load);
   else prepare_friction(c, block, a, b, ra0, rb0);
+}
+
+void Solver::store_impulses(Contact& c, std::size_t slot) const {
+  const ContactImpulses& impulses = impulses_[slot];
+  for (int i = 0; i < c.count; ++i) c.points[i].normal_impulse = impulses.normal[i];
+  c.friction_impulse = impulses.friction;
 }
 
 }  // namespace tumble

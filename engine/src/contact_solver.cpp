@@ -58,14 +58,15 @@ int Solver::impact(Contact& c, const Vec3& gravity, double dt) {
   return 1;
 }
 
-void Solver::warm_start(Contact& c, std::size_t index) {
-  SolverBody& a = side(c.a);
-  SolverBody& b = side(c.b);
-  const ContactRows& rows = rows_[index];
-  for (int i = 0; i < c.count; ++i)
-    push(a, b, a.inv_mass, b.inv_mass, rows.dir[0], rows.points[i], c.points[i].normal_impulse);
+void Solver::warm_start(std::size_t slot) {
+  const ContactRows& rows = rows_[slot];
+  SolverBody& a = at(rows.a);
+  SolverBody& b = at(rows.b);
+  const ContactImpulses& impulses = impulses_[slot];
+  for (int i = 0; i < rows.count; ++i)
+    push(a, b, a.inv_mass, b.inv_mass, rows.dir[0], rows.points[i], impulses.normal[i]);
   const FrictionRows& f = rows.friction;
-  const std::array<double, 3>& j = c.friction_impulse;
+  const std::array<double, 3>& j = impulses.friction;
   const Vec3 linear = j[0] * rows.dir[1] + j[1] * rows.dir[2];
   if (a.inv_mass > 0.0) {
     a.v -= a.inv_mass * linear;
@@ -87,13 +88,13 @@ namespace {
 // comes from the warm-started normal impulses (the points' centroid when there are none):
 // at the plain centroid, a box resting off-centre on another in a settling pile rocked and
 // slid at 0.05 m/s for tens of seconds.
-void solve_friction(Contact& c, const ContactRows& rows, Motion& a, Motion& b, double ma,
-                    double mb) {
+void solve_friction(const ContactRows& rows, ContactImpulses& impulses, Motion& a, Motion& b,
+                    double ma, double mb) {
   const FrictionRows& f = rows.friction;
   double load = 0.0;
-  for (int i = 0; i < c.count; ++i) load += c.points[i].normal_impulse;
-  const double limit = c.friction * load;
-  std::array<double, 3>& total = c.friction_impulse;
+  for (int i = 0; i < rows.count; ++i) load += impulses.normal[i];
+  const double limit = rows.mu * load;
+  std::array<double, 3>& total = impulses.friction;
   const Vec3 dv = b.v - a.v;
   const double old0 = total[0], old1 = total[1];
   double n0 = old0 - f.mass[0] * (rows.dir[1].dot(dv) + b.w.dot(f.ang_b[0]) - a.w.dot(f.ang_a[0]));
@@ -135,9 +136,9 @@ void solve_friction(Contact& c, const ContactRows& rows, Motion& a, Motion& b, d
 // changes by dᵢ·z, and their sum moves the bodies by the wrench u = G z along the columns C.
 // Per point only one dot product remains, so a four-point face costs about half the
 // point-by-point form it replaced and an eight-vertex floor contact a third.
-bool solve_normal_block(Contact& c, const ContactRows& rows, Motion& a, Motion& b, double ma,
-                        double mb) {
-  const int n = c.count;
+bool solve_normal_block(const ContactRows& rows, ContactImpulses& impulses, Motion& a, Motion& b,
+                        double ma, double mb) {
+  const int n = rows.count;
   const Vec3 wr = b.w - a.w;
   const Vec3 y(rows.dir[0].dot(b.v - a.v) + b.w.dot(rows.cb[0]) - a.w.dot(rows.ca[0]),
                wr.dot(rows.ca[1]), wr.dot(rows.ca[2]));
@@ -145,11 +146,11 @@ bool solve_normal_block(Contact& c, const ContactRows& rows, Motion& a, Motion& 
   std::array<double, kMaxContactPoints> next{};
   bool pushes = true;
   for (int i = 0; i < n; ++i) {
-    next[i] = c.points[i].normal_impulse + rows.D.row(i).dot(z);
+    next[i] = impulses.normal[i] + rows.D.row(i).dot(z);
     pushes = pushes && next[i] >= 0.0;
   }
   if (pushes) {
-    for (int i = 0; i < n; ++i) c.points[i].normal_impulse = next[i];
+    for (int i = 0; i < n; ++i) impulses.normal[i] = next[i];
     const Vec3 u = rows.G * z;
     if (ma > 0.0) {
       a.v -= (ma * u(0)) * rows.dir[0];
@@ -163,19 +164,20 @@ bool solve_normal_block(Contact& c, const ContactRows& rows, Motion& a, Motion& 
 }
 
 /// The sweep of one contact on velocities held in locals.
-void solve_velocity_rows(Contact& c, const ContactRows& rows, Motion& a, Motion& b, double ma,
-                         double mb, double dt) {
-  solve_friction(c, rows, a, b, ma, mb);
-  const int n = c.count;
+void solve_velocity_rows(const ContactRows& rows, ContactImpulses& impulses, Motion& a,
+                         Motion& b, double ma, double mb) {
+  solve_friction(rows, impulses, a, b, ma, mb);
+  const int n = rows.count;
   // One point: the clamped sweep below is the block step.
-  if (n > 1 && solve_normal_block(c, rows, a, b, ma, mb)) return;
+  if (n > 1 && solve_normal_block(rows, impulses, a, b, ma, mb)) return;
   for (int i = 0; i < n; ++i) {
-    ContactPoint& p = c.points[i];
-    const double vn = Solver::normal_speed(a, b, rows.dir[0], rows.points[i]);
-    const double next_i = std::max(0.0, p.normal_impulse - p.normal_mass * (vn - Solver::target_of(p, dt)));
-    const double delta = next_i - p.normal_impulse;
-    p.normal_impulse = next_i;
-    Solver::push(a, b, ma, mb, rows.dir[0], rows.points[i], delta);
+    const PointRows& r = rows.points[i];
+    const double vn = Solver::normal_speed(a, b, rows.dir[0], r);
+    double& impulse = impulses.normal[i];
+    const double next_i = std::max(0.0, impulse - r.normal_mass * (vn - r.target));
+    const double delta = next_i - impulse;
+    impulse = next_i;
+    Solver::push(a, b, ma, mb, rows.dir[0], r, delta);
   }
 }
 
@@ -189,14 +191,15 @@ void solve_velocity_rows(Contact& c, const ContactRows& rows, Motion& a, Motion&
 // only their change has to converge. Speculative points (Catto GDC 2013; Box2D, Jolt) may
 // approach by their gap within the step but no more, so a falling body stops at the surface
 // instead of penetrating first.
-void Solver::solve_velocity(Contact& c, std::size_t index, double dt) {
-  SolverBody& body_a = side(c.a);
-  SolverBody& body_b = side(c.b);
+void Solver::solve_velocity(std::size_t slot) {
+  const ContactRows& rows = rows_[slot];
+  SolverBody& body_a = at(rows.a);
+  SolverBody& body_b = at(rows.b);
   // The two bodies' velocities in locals for the whole contact: the compiler keeps them in
   // registers instead of storing them after every row (a third of the sweep's instructions).
   Motion a{body_a.v, body_a.w}, b{body_b.v, body_b.w};
   const double ma = body_a.inv_mass, mb = body_b.inv_mass;
-  solve_velocity_rows(c, rows_[index], a, b, ma, mb, dt);
+  solve_velocity_rows(rows, impulses_[slot], a, b, ma, mb);
   if (ma > 0.0) body_a.v = a.v, body_a.w = a.w;  // not the floor, which a colour's contacts share
   body_b.v = b.v;
   body_b.w = b.w;
@@ -224,10 +227,10 @@ NormalSystem Solver::normal_system_of(const Contact& c, const SolverBody* a,
 // Split impulse (Catto, GDC 2006 notes; Bullet's splitImpulse): penetration beyond the slop is
 // removed by pseudo velocities that move the positions but never enter the momenta, so the
 // correction adds no energy (Baumgarte's bias would make stacks bounce).
-void Solver::solve_position(Contact& c, std::size_t index, const SolverSettings& s, double dt) {
-  SolverBody& a = side(c.a);
-  SolverBody& b = side(c.b);
-  const ContactRows& rows = rows_[index];
+void Solver::solve_position(Contact& c, std::size_t slot, const SolverSettings& s, double dt) {
+  const ContactRows& rows = rows_[slot];
+  SolverBody& a = at(rows.a);
+  SolverBody& b = at(rows.b);
   const Vec3& n = rows.dir[0];
   for (int i = 0; i < c.count; ++i) {
     ContactPoint& p = c.points[i];
@@ -325,7 +328,13 @@ void warm_start_from(Contact& contact, const Contact& previous) {
 
 namespace {
 
-/// Runs fn(contact, index) over the contacts `passes` times, colour by colour, each colour
+// Colours of under kShared contacts on average (`pyramid`: ~10) leave each thread a chunk or
+// two per colour, whose waits cost more than the second thread saves: such a solve runs on
+// the owner's thread in contact order.
+constexpr std::size_t kShared = 24;
+
+/// Runs fn(contact, slot) over the contacts `passes` times (slot: the contact's rows, in sweep
+/// order), colour by colour when the solve has colours, each colour
 /// shared among the pool's threads (its contacts touch disjoint bodies). All the passes' colours
 /// are the phases of one job: `pile`'s ~40 colours × 12 velocity iterations were ~500 jobs a
 /// step, whose publication and idle chunks took as long as the second thread saved.
@@ -342,11 +351,8 @@ template <typename Fn>
 void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool, Fn&& fn,
            int passes = 1) {
   constexpr std::size_t kGrain = 8;  // contacts per chunk: 0.1–0.5 µs each
-  // Colours of under kShared contacts on average (`pyramid`: ~10) leave each thread a chunk
-  // or two per colour, whose waits cost more than the second thread saves.
-  constexpr std::size_t kShared = 24;
   ContactColours& colours = scratch.colours;
-  if (pool.size() == 1 || contacts.size() < kShared * colours.count()) {
+  if (pool.size() == 1 || colours.count() == 0) {
     // Contact order: what the colours replay, without their cost.
     for (int pass = 0; pass < passes; ++pass)
       for (std::size_t i = 0; i < contacts.size(); ++i) fn(contacts[i], i);
@@ -358,14 +364,14 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
       count * static_cast<std::size_t>(passes), kGrain,
       [&](std::size_t phase) { return colours.of(phase % count).size(); },
       [&](std::size_t phase, std::size_t begin, std::size_t end) {
-        const std::span<const std::uint32_t> colour = colours.of(phase % count);
+        const std::size_t start = colours.offset[phase % count];
         const auto pass = static_cast<std::uint32_t>(phase / count);
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::uint32_t k = colour[i];
+        for (std::size_t slot = start + begin; slot < start + end; ++slot) {
+          const std::uint32_t k = colours.order[slot];
           const std::int32_t a = scratch.colour_a[k], b = scratch.colour_b[k];
           if (a >= 0) wait_turn(colours.turns[a], pass * colours.degree[a] + colours.rank_a[k]);
           if (b >= 0) wait_turn(colours.turns[b], pass * colours.degree[b] + colours.rank_b[k]);
-          fn(contacts[k], k);
+          fn(contacts[k], slot);
           if (a >= 0) pass_turn(colours.turns[a]);
           if (b >= 0) pass_turn(colours.turns[b]);
         }
@@ -393,7 +399,8 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
                    const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool) {
   constexpr std::size_t kBodyGrain = 128;
   Solver solver(bodies, solver_bodies, scratch, pool, dt * gravity);
-  scratch.colours.offset.clear();  // one thread: no colours, the sweeps go in contact order
+  ContactColours& colours = scratch.colours;
+  colours.offset.clear();  // one thread: no colours, the sweeps go in contact order
   if (pool.size() > 1) {
     // Each contact's two solver bodies, read on the pool: a contact is ~1 KB, and on the
     // owner's thread alone this read missed the cache once per contact.
@@ -405,17 +412,23 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
         scratch.colour_b[i] = scratch.index[contacts[i].b];
       }
     });
-    colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), scratch.colours);
+    colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), colours);
+    if (contacts.size() < kShared * colours.count()) colours.offset.clear();
   }
+  // Rows slot k holds the contact the sweeps meet k-th: colour by colour, else contact order.
+  const bool coloured = colours.count() > 0;
+  auto contact_at = [&](std::size_t slot) { return coloured ? colours.order[slot] : slot; };
   if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
+  if (scratch.impulses.size() < contacts.size()) scratch.impulses.resize(contacts.size());
   // Whether any point is deeper than the slop is found while each contact is in cache; the
   // separations are the step start's and the solve does not change them.
   std::atomic<bool> deep{false};
   pool.for_each(contacts.size(), 32, [&](std::size_t begin, std::size_t end) {
     bool any = false;
-    for (std::size_t i = begin; i < end; ++i) {
-      solver.prepare(contacts[i], i, dt);
-      any = any || deeper_than(contacts[i], settings.slop);
+    for (std::size_t slot = begin; slot < end; ++slot) {
+      Contact& c = contacts[contact_at(slot)];
+      solver.prepare(c, slot, dt);
+      any = any || deeper_than(c, settings.slop);
     }
     if (any) deep.store(true, std::memory_order_relaxed);
   });
@@ -423,16 +436,21 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   sweep(scratch, contacts, pool, [&](Contact& c, std::size_t) {
     if (solver.impact(c, gravity, dt)) impacts.fetch_add(1, std::memory_order_relaxed);
   });
-  sweep(scratch, contacts, pool, [&](Contact& c, std::size_t i) { solver.warm_start(c, i); });
-  sweep(scratch, contacts, pool, [&](Contact& c, std::size_t i) { solver.solve_velocity(c, i, dt); },
+  sweep(scratch, contacts, pool, [&](Contact&, std::size_t slot) { solver.warm_start(slot); });
+  sweep(scratch, contacts, pool, [&](Contact&, std::size_t slot) { solver.solve_velocity(slot); },
         settings.velocity_iterations);
+  // Shock propagation and the next step's warm start read the impulses in the contacts.
+  pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t slot = begin; slot < end; ++slot)
+      solver.store_impulses(contacts[contact_at(slot)], slot);
+  });
   if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt, pool);
   // The split impulse starts from zero pseudo velocities and only pushes: while no point is
   // deeper than the slop every target is ≤ 0 and every sweep would leave all of them zero (a
   // resting stack: `pyramid` spent 6 % of its instructions proving that).
   if (deep.load(std::memory_order_relaxed))
     sweep(scratch, contacts, pool,
-          [&](Contact& c, std::size_t i) { solver.solve_position(c, i, settings, dt); },
+          [&](Contact& c, std::size_t slot) { solver.solve_position(c, slot, settings, dt); },
           settings.position_iterations);
   pool.for_each(solver_bodies.size(), kBodyGrain,
                 [&](std::size_t begin, std::size_t end) { solver.finish(begin, end); });

@@ -80,10 +80,12 @@ struct SolverBody {
 /// One contact point's row along the normal, computed once a step so that the iterations are
 /// dot products and axpys (Box2D's contact solver).
 struct PointRows {
-  Vec3 ang_a;  ///< ra × n, m (zero for the floor).
-  Vec3 ang_b;  ///< rb × n, m.
-  Vec3 inv_a;  ///< I_a⁻¹ (ra × n), 1/(kg·m).
-  Vec3 inv_b;  ///< I_b⁻¹ (rb × n), 1/(kg·m).
+  Vec3 ang_a;          ///< ra × n, m (zero for the floor).
+  Vec3 ang_b;          ///< rb × n, m.
+  Vec3 inv_a;          ///< I_a⁻¹ (ra × n), 1/(kg·m).
+  Vec3 inv_b;          ///< I_b⁻¹ (rb × n), 1/(kg·m).
+  double normal_mass;  ///< 1 / (n·K n), kg (ContactPoint::normal_mass).
+  double target;       ///< Normal speed the point must reach (Solver::target_of), m/s.
 };
 
 /// A contact's three friction rows: t1 and t2 at the patch's centre of pressure, the twist
@@ -100,7 +102,17 @@ struct FrictionRows {
 /// are vn = D y with y = (normal speed at the patch origin, the two tipping rates), and an
 /// impulse Δλ = D z moves the bodies by the patch wrench u = G z, G = DᵀD: a block iteration
 /// works on 3-vectors whatever the number of points.
+///
+/// The velocity passes read the rows and write the contact's ContactImpulses alone, not the
+/// Contact: the rows hold the contact's bodies, and the impulses its points' accumulated normal
+/// impulses and its patch friction while the passes run (Solver::store_impulses puts them
+/// back). Both lie in the order the passes meet them (colour by colour on several threads), so
+/// each thread streams through memory instead of gathering ~1 KB contacts from all over the
+/// list.
 struct ContactRows {
+  std::int32_t a = -1, b = -1;  ///< Solver index of each body (−1: the floor).
+  int count = 0;                ///< Points in use.
+  double mu = 0.0;              ///< Coulomb μ of the pair (Contact::friction).
   std::array<Vec3, 3> dir;  ///< n, t1, t2 (unit, world).
   PlaneCoordinates D;       ///< (1, α, β) of each point.
   Mat3 G = Mat3::Zero();    ///< DᵀD.
@@ -112,11 +124,18 @@ struct ContactRows {
   std::array<PointRows, kMaxContactPoints> points;  ///< Normal row of each point.
 };
 
+/// A contact's accumulated impulses during the velocity passes (Contact's, copied in and out).
+struct ContactImpulses {
+  std::array<double, kMaxContactPoints> normal{};  ///< Each point's normal impulse, N·s.
+  std::array<double, 3> friction{};                ///< Contact::friction_impulse.
+};
+
 /// The solver's buffers, reused between steps.
 struct SolverScratch {
   std::vector<SolverBody> bodies;     ///< One per solver body, in the order given.
   std::vector<std::int32_t> index;    ///< Body id → position in `bodies`, −1 when absent.
-  std::vector<ContactRows> rows;      ///< Solver rows of each contact.
+  std::vector<ContactRows> rows;      ///< Solver rows of each contact, in sweep order.
+  std::vector<ContactImpulses> impulses;  ///< Impulses of each contact, in sweep order.
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
   std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
   std::vector<std::uint32_t> waves, wave_of, wave_start, wave_order;  ///< Its waves.

@@ -37,8 +37,8 @@ class Solver {
   Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch,
          WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
-        rows_(scratch.rows), fixed_(scratch.fixed), order_(scratch.order),
-        waves_(scratch.waves), wave_of_(scratch.wave_of), wave_start_(scratch.wave_start),
+        rows_(scratch.rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
+        order_(scratch.order), waves_(scratch.waves), wave_of_(scratch.wave_of), wave_start_(scratch.wave_start),
         wave_order_(scratch.wave_order), group_start_(scratch.group_start) {
     index_.resize(bodies.size(), -1);
     fixed_ = SolverBody{};
@@ -69,9 +69,12 @@ class Solver {
     if (a) a->v -= a->inv_mass * j, a->w -= a->inv_inertia * ra.cross(j);
     if (b) b->v += b->inv_mass * j, b->w += b->inv_inertia * rb.cross(j);
   }
-  /// The step's rows of contact `c` (its n-th): the points' offsets and normal rows, the
-  /// normal block and the patch friction (contact_rows.cpp). Thread-safe across contacts.
-  void prepare(Contact& c, std::size_t n, double dt);
+  /// The step's rows of contact `c` in rows slot `slot`: the points' offsets and normal rows,
+  /// the normal block, the patch friction and the accumulated impulses (contact_rows.cpp).
+  /// Thread-safe across contacts.
+  void prepare(Contact& c, std::size_t slot, double dt);
+  /// Puts the accumulated impulses of rows slot `slot` back into its contact c.
+  void store_impulses(Contact& c, std::size_t slot) const;
 
   /// The collision pass of contact c: its fast-approaching points' exact impulses; 1 when it
   /// had an impact, else 0.
@@ -93,14 +96,16 @@ class Solver {
   /// at j), 1/kg; a or b null: that body is held fixed.
   static NormalSystem normal_system_of(const Contact& c, const SolverBody* a,
                                        const SolverBody* b);
-  /// Applies contact c's accumulated impulses (its index-th rows) to its bodies.
-  void warm_start(Contact& c, std::size_t index);
-  /// One sequential-impulse sweep of contact c: patch friction, then the normal block.
-  void solve_velocity(Contact& c, std::size_t index, double dt);
-  /// One split-impulse sweep of contact c on the pseudo velocities.
-  void solve_position(Contact& c, std::size_t index, const SolverSettings& s, double dt);
+  /// Applies the accumulated impulses of rows slot `slot` to its bodies.
+  void warm_start(std::size_t slot);
+  /// One sequential-impulse sweep of rows slot `slot`: patch friction, then the normal block.
+  void solve_velocity(std::size_t slot);
+  /// One split-impulse sweep of contact c (rows slot `slot`) on the pseudo velocities.
+  void solve_position(Contact& c, std::size_t slot, const SolverSettings& s, double dt);
   /// The solver body of id, or the fixed stand-in for the floor.
   SolverBody& side(std::uint32_t id) { return id == kStaticBody ? fixed_ : sb_[index_[id]]; }
+  /// The solver body at solver index k, or the fixed stand-in for the floor (k < 0).
+  SolverBody& at(std::int32_t k) { return k < 0 ? fixed_ : sb_[k]; }
   /// Relative normal velocity of b over a at a point (row r, normal n), m/s. Body: anything
   /// with velocities v and w (a SolverBody, or a Motion held in registers).
   template <typename Body>
@@ -137,6 +142,7 @@ class Solver {
   std::vector<std::int32_t>& index_;
   std::vector<SolverBody>& sb_;
   std::vector<ContactRows>& rows_;  // solver rows of each contact
+  std::vector<ContactImpulses>& impulses_;  // their impulses during the velocity passes
   SolverBody& fixed_;               // the floor: absorbs impulses without moving
   std::vector<std::pair<double, std::uint32_t>>& order_;
   std::vector<std::uint32_t>& waves_;       // latest shock-propagation wave of each body

@@ -38,7 +38,7 @@ struct StepStats {
   std::uint32_t contact_points = 0;  ///< Points in those contacts.
   std::uint32_t islands = 0;         ///< Islands of touching bodies solved together.
   std::uint32_t solver_bodies = 0;   ///< Bodies stepped by the contact solver.
-  std::uint32_t colours = 0;         ///< Colours of the solver's contacts (0 on one thread).
+  std::uint32_t colours = 0;         ///< Colours the contacts were swept by (0: contact order).
   /// 1 when the broad phase stopped at its pair budget (32 per body + 1,024): bodies packed
   /// into one another beyond it were not tested against each other this step.
   std::uint32_t pair_budget_exceeded = 0;
