@@ -38,8 +38,9 @@ class Solver {
          WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
         rows_(scratch.rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
-        order_(scratch.order), waves_(scratch.waves), wave_of_(scratch.wave_of), wave_start_(scratch.wave_start),
-        wave_order_(scratch.wave_order), group_start_(scratch.group_start) {
+        order_(scratch.order), waves_(scratch.waves), wave_of_(scratch.wave_of),
+        wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
+        group_start_(scratch.group_start) {
     index_.resize(bodies.size(), -1);
     fixed_ = SolverBody{};
     sb_.resize(ids.size());
