@@ -102,11 +102,11 @@ struct BodyVelocity {
 struct StepScratch {
   std::vector<BodyPair> pairs;          ///< Broad-phase pairs (sorted).
   std::vector<Contact> contacts;        ///< Floor contacts of island bodies, then box–box.
-  std::vector<Contact> box_contacts;    ///< Box–box contacts before they join `contacts`.
   std::vector<BoxManifold> manifolds;   ///< Manifold of each pair with points (slot ≥ 0).
   std::vector<BodyVelocity> velocities; ///< Awake bodies' velocities (narrow phase, by body).
   std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
-  std::vector<std::int32_t> slot;       ///< Position of each pair's (body's) contact, or −1.
+  std::vector<std::int32_t> slot;       ///< Position of each pair's box–box contact, or −1.
+  std::vector<std::int32_t> floor_slot; ///< Position of each linked body's floor contact, or −1.
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<std::uint8_t> marked;     ///< Scratch of `linked`: body is in a box–box contact.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.
