@@ -83,7 +83,6 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt) {
     ContactPoint& p = c.points[i];
     p.ra = c.a == kStaticBody ? p.position : Vec3(p.position - bodies_[c.a].s.x);
     p.rb = p.position - bodies_[c.b].s.x;
-    p.pseudo_impulse = 0.0;
     ra0 += p.ra;
     rb0 += p.rb;
     PointRows& r = block.points[i];
@@ -96,7 +95,9 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt) {
     p.normal_mass = 1.0 / k;
     r.normal_mass = p.normal_mass;
     r.target = target_of(p, dt);
+    r.separation = p.separation;
     impulses.normal[i] = p.normal_impulse;
+    impulses.pseudo[i] = 0.0;
   }
   ra0 /= c.count;
   rb0 /= c.count;

@@ -227,23 +227,23 @@ NormalSystem Solver::normal_system_of(const Contact& c, const SolverBody* a,
 // Split impulse (Catto, GDC 2006 notes; Bullet's splitImpulse): penetration beyond the slop is
 // removed by pseudo velocities that move the positions but never enter the momenta, so the
 // correction adds no energy (Baumgarte's bias would make stacks bounce).
-void Solver::solve_position(Contact& c, std::size_t slot, const SolverSettings& s, double dt) {
+void Solver::solve_position(std::size_t slot, const SolverSettings& s, double dt) {
   const ContactRows& rows = rows_[slot];
+  std::array<double, kMaxContactPoints>& pseudo = impulses_[slot].pseudo;
   SolverBody& a = at(rows.a);
   SolverBody& b = at(rows.b);
   const Vec3& n = rows.dir[0];
-  for (int i = 0; i < c.count; ++i) {
-    ContactPoint& p = c.points[i];
+  for (int i = 0; i < rows.count; ++i) {
     const PointRows& r = rows.points[i];
     // Pseudo velocities obey the contacts too: a touching point may not be pushed deeper by
     // the correction of another contact (a box pressed into the floor by the one above it).
-    const double target = p.separation > 0.0
-                              ? -p.separation / dt
-                              : s.position_gain * std::max(-p.separation - s.slop, 0.0) / dt;
+    const double target = r.separation > 0.0
+                              ? -r.separation / dt
+                              : s.position_gain * std::max(-r.separation - s.slop, 0.0) / dt;
     const double vn = n.dot(b.vp - a.vp) + b.wp.dot(r.ang_b) - a.wp.dot(r.ang_a);
-    const double next = std::max(0.0, p.pseudo_impulse + p.normal_mass * (target - vn));
-    const double delta = next - p.pseudo_impulse;
-    p.pseudo_impulse = next;
+    const double next = std::max(0.0, pseudo[i] + r.normal_mass * (target - vn));
+    const double delta = next - pseudo[i];
+    pseudo[i] = next;
     if (delta == 0.0) continue;
     if (a.inv_mass > 0.0) {  // not the floor, which contacts of one colour share
       a.vp -= (a.inv_mass * delta) * n;
@@ -450,7 +450,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   // resting stack: `pyramid` spent 6 % of its instructions proving that).
   if (deep.load(std::memory_order_relaxed))
     sweep(scratch, contacts, pool,
-          [&](Contact& c, std::size_t slot) { solver.solve_position(c, slot, settings, dt); },
+          [&](Contact&, std::size_t slot) { solver.solve_position(slot, settings, dt); },
           settings.position_iterations);
   pool.for_each(solver_bodies.size(), kBodyGrain,
                 [&](std::size_t begin, std::size_t end) { solver.finish(begin, end); });

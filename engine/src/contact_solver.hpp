@@ -28,7 +28,6 @@ struct ContactPoint {
   // Per-step solver data.
   Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  ///< Offsets from the centres of mass, m.
   double normal_mass = 0.0;                   ///< 1 / (n·K n), kg.
-  double pseudo_impulse = 0.0;                ///< Split-impulse position correction, N·s.
 };
 
 /// The contact of body a (or the floor, a = kStaticBody) with body b: normal from a to b.
@@ -86,6 +85,7 @@ struct PointRows {
   Vec3 inv_b;          ///< I_b⁻¹ (rb × n), 1/(kg·m).
   double normal_mass;  ///< 1 / (n·K n), kg (ContactPoint::normal_mass).
   double target;       ///< Normal speed the point must reach (Solver::target_of), m/s.
+  double separation;   ///< ContactPoint::separation, m (the split impulse's target).
 };
 
 /// A contact's three friction rows: t1 and t2 at the patch's centre of pressure, the twist
@@ -103,12 +103,12 @@ struct FrictionRows {
 /// impulse Δλ = D z moves the bodies by the patch wrench u = G z, G = DᵀD: a block iteration
 /// works on 3-vectors whatever the number of points.
 ///
-/// The velocity passes read the rows and write the contact's ContactImpulses alone, not the
-/// Contact: the rows hold the contact's bodies, and the impulses its points' accumulated normal
-/// impulses and its patch friction while the passes run (Solver::store_impulses puts them
-/// back). Both lie in the order the passes meet them (colour by colour on several threads), so
-/// each thread streams through memory instead of gathering ~1 KB contacts from all over the
-/// list.
+/// The velocity and position passes read the rows and write the contact's ContactImpulses
+/// alone, not the Contact: the rows hold the contact's bodies, and the impulses its points'
+/// accumulated normal impulses and its patch friction while the passes run
+/// (Solver::store_impulses puts them back) and its split impulses. Both lie in the order the
+/// passes meet them (colour by colour on several threads), so each thread streams through
+/// memory instead of gathering ~1 KB contacts from all over the list.
 struct ContactRows {
   std::int32_t a = -1, b = -1;  ///< Solver index of each body (−1: the floor).
   int count = 0;                ///< Points in use.
@@ -124,10 +124,12 @@ struct ContactRows {
   std::array<PointRows, kMaxContactPoints> points;  ///< Normal row of each point.
 };
 
-/// A contact's accumulated impulses during the velocity passes (Contact's, copied in and out).
+/// A contact's accumulated impulses during the velocity passes (Contact's, copied in and out)
+/// and the split impulse's, which live for the step only.
 struct ContactImpulses {
   std::array<double, kMaxContactPoints> normal{};  ///< Each point's normal impulse, N·s.
   std::array<double, 3> friction{};                ///< Contact::friction_impulse.
+  std::array<double, kMaxContactPoints> pseudo{};  ///< Each point's split impulse, N·s.
 };
 
 /// The solver's buffers, reused between steps.

@@ -101,8 +101,8 @@ class Solver {
   void warm_start(std::size_t slot);
   /// One sequential-impulse sweep of rows slot `slot`: patch friction, then the normal block.
   void solve_velocity(std::size_t slot);
-  /// One split-impulse sweep of contact c (rows slot `slot`) on the pseudo velocities.
-  void solve_position(Contact& c, std::size_t slot, const SolverSettings& s, double dt);
+  /// One split-impulse sweep of rows slot `slot` on the pseudo velocities.
+  void solve_position(std::size_t slot, const SolverSettings& s, double dt);
   /// The solver body of id, or the fixed stand-in for the floor.
   SolverBody& side(std::uint32_t id) { return id == kStaticBody ? fixed_ : sb_[index_[id]]; }
   /// The solver body at solver index k, or the fixed stand-in for the floor (k < 0).
