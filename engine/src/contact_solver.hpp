@@ -132,6 +132,14 @@ struct ContactImpulses {
   std::array<double, kMaxContactPoints> pseudo{};  ///< Each point's split impulse, N·s.
 };
 
+/// One support contact in shock propagation's order: the height of the body it holds up (m,
+/// along −gravity), that body, and the contact's index.
+struct SupportEntry {
+  double height;
+  std::uint32_t upper;
+  std::uint32_t contact;
+};
+
 /// The solver's buffers, reused between steps.
 struct SolverScratch {
   std::vector<SolverBody> bodies;     ///< One per solver body, in the order given.
@@ -139,7 +147,7 @@ struct SolverScratch {
   std::vector<ContactRows> rows;      ///< Solver rows of each contact, in sweep order.
   std::vector<ContactImpulses> impulses;  ///< Impulses of each contact, in sweep order.
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
-  std::vector<std::pair<double, std::uint32_t>> order;  ///< Shock propagation order.
+  std::vector<SupportEntry> order;    ///< Shock propagation order.
   std::vector<std::uint32_t> waves, wave_of, wave_start, wave_order;  ///< Its waves.
   std::vector<std::uint32_t> group_start;  ///< Its solves: each body's supports in `order`.
   std::vector<std::int32_t> colour_a, colour_b;  ///< Solver index of each contact's bodies.

@@ -37,7 +37,7 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   const double g = gravity.norm();
   if (g == 0.0) return;
   const Vec3 up = -gravity / g;
-  std::vector<std::pair<double, std::uint32_t>>& order = order_;
+  std::vector<SupportEntry>& order = order_;  // (height, body held up, contact)
   order.clear();
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     // A contact whose normal is nearly horizontal supports nothing and is left to the
@@ -45,19 +45,18 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     // floor does not move, and the body under it has no support to be pushed from.
     const std::uint32_t upper = upper_of(contacts[i], up);
     if (std::abs(contacts[i].normal.dot(up)) >= kSupportCosine && upper != kStaticBody)
-      order.emplace_back(up.dot(bodies_[upper].s.x), static_cast<std::uint32_t>(i));
+      order.push_back({up.dot(bodies_[upper].s.x), upper, static_cast<std::uint32_t>(i)});
   }
-  // By the height of the supported body, its contacts together (in contact order).
-  std::sort(order.begin(), order.end(), [&](const auto& p, const auto& q) {
-    if (p.first != q.first) return p.first < q.first;
-    const std::uint32_t up_p = upper_of(contacts[p.second], up);
-    const std::uint32_t up_q = upper_of(contacts[q.second], up);
-    return up_p != up_q ? up_p < up_q : p.second < q.second;
+  // By the height of the supported body, its contacts together (in contact order). The
+  // entries carry the body, so the sort reads no contact (a ~1 KB record, on the caller's
+  // thread: every comparison of a tie missed the cache twice).
+  std::sort(order.begin(), order.end(), [](const SupportEntry& p, const SupportEntry& q) {
+    if (p.height != q.height) return p.height < q.height;
+    return p.upper != q.upper ? p.upper < q.upper : p.contact < q.contact;
   });
   group_start_.clear();
   for (std::size_t k = 0; k < order.size(); ++k)
-    if (k == 0 || upper_of(contacts[order[k].second], up) !=
-                      upper_of(contacts[order[k - 1].second], up))
+    if (k == 0 || order[k].upper != order[k - 1].upper)
       group_start_.push_back(static_cast<std::uint32_t>(k));
   const std::size_t groups = group_start_.size();
   group_start_.push_back(static_cast<std::uint32_t>(order.size()));
@@ -76,7 +75,7 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     std::uint32_t wave = 0;
     auto each_body = [&](auto&& fn) {
       for (std::uint32_t k = group_start_[gi]; k < group_start_[gi + 1]; ++k) {
-        const Contact& c = contacts[order[k].second];
+        const Contact& c = contacts[order[k].contact];
         if (c.a != kStaticBody) fn(waves_[index_[c.a]]);
         fn(waves_[index_[c.b]]);
       }
@@ -110,31 +109,30 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
 /// the iterations left, over all the points at once when they share a normal (else contact by
 /// contact, as when they do not fit one solve).
 void Solver::push_up_body(std::span<Contact> contacts,
-                          std::span<const std::pair<double, std::uint32_t>> group,
-                          const Vec3& up, double dt) {
+                          std::span<const SupportEntry> group, const Vec3& up, double dt) {
   constexpr double kParallel = 1.0 - 1e-9;  // cosine between normals solved as one
-  const Contact& first = contacts[group[0].second];
+  const Contact& first = contacts[group[0].contact];
   const Vec3 n = first.normal.dot(up) > 0.0 ? first.normal : Vec3(-first.normal);
   int m = 0;
   bool together = group.size() > 1;
-  for (const auto& [h, i] : group) {
-    const Contact& c = contacts[i];
+  for (const SupportEntry& e : group) {
+    const Contact& c = contacts[e.contact];
     m += c.count;
     together = together && std::abs(c.normal.dot(n)) >= kParallel;
   }
   if (!together || m > kMaxActiveSetPoints) {
-    for (const auto& [h, i] : group) push_up(contacts[i], up, dt);
+    for (const SupportEntry& e : group) push_up(contacts[e.contact], up, dt);
     return;
   }
-  const std::uint32_t id = upper_of(first, up);
+  const std::uint32_t id = group[0].upper;
   SolverBody* upper = body(id);
   std::array<Vec3, kMaxActiveSetPoints> r;  // points from the body's centre, m
   std::array<ContactPoint*, kMaxActiveSetPoints> points{};
   PointVector vn(m), target(m);
   bool approaching = false;
   int k = 0;
-  for (const auto& [h, i] : group) {
-    Contact& c = contacts[i];
+  for (const SupportEntry& e : group) {
+    Contact& c = contacts[e.contact];
     const bool upper_is_b = c.b == id;
     const SolverBody* support = body(upper_is_b ? c.a : c.b);
     for (int q = 0; q < c.count; ++q, ++k) {

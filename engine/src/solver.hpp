@@ -87,7 +87,7 @@ class Solver {
   void push_up(Contact& c, const Vec3& up, double dt);
   /// Shock propagation of one body on all its supports (`group` of contacts) at once.
   void push_up_body(std::span<Contact> contacts,
-                    std::span<const std::pair<double, std::uint32_t>> group, const Vec3& up,
+                    std::span<const SupportEntry> group, const Vec3& up,
                     double dt);
   /// The body a support contact holds up (the one the normal, oriented up, points into).
   static std::uint32_t upper_of(const Contact& c, const Vec3& up) {
@@ -145,7 +145,7 @@ class Solver {
   std::vector<ContactRows>& rows_;  // solver rows of each contact
   std::vector<ContactImpulses>& impulses_;  // their impulses during the velocity passes
   SolverBody& fixed_;               // the floor: absorbs impulses without moving
-  std::vector<std::pair<double, std::uint32_t>>& order_;
+  std::vector<SupportEntry>& order_;
   std::vector<std::uint32_t>& waves_;       // latest shock-propagation wave of each body
   std::vector<std::uint32_t>& wave_of_;     // wave of each group
   std::vector<std::uint32_t>& wave_start_;  // start of each wave in wave_order_
