@@ -50,7 +50,7 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
   }
   Mat3 P = Mat3::Zero();
   if (c.count == 1) {
-    P(0, 0) = c.points[0].normal_mass;
+    P(0, 0) = rows.points[0].normal_mass;
   } else {
     Mat3 S;
     for (int i = 0; i < 3; ++i)
@@ -92,8 +92,7 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt) {
     r.inv_b = b->inv_inertia * r.ang_b;
     const double k = (a ? a->inv_mass + r.ang_a.dot(r.inv_a) : 0.0) + b->inv_mass +
                      r.ang_b.dot(r.inv_b);  // n·K n, 1/kg
-    p.normal_mass = 1.0 / k;
-    r.normal_mass = p.normal_mass;
+    r.normal_mass = 1.0 / k;
     r.target = target_of(p, dt);
     r.separation = p.separation;
     impulses.normal[i] = p.normal_impulse;

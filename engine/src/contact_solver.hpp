@@ -27,7 +27,6 @@ struct ContactPoint {
   double normal_impulse = 0.0;   ///< Accumulated normal impulse, N·s (≥ 0).
   // Per-step solver data.
   Vec3 ra = Vec3::Zero(), rb = Vec3::Zero();  ///< Offsets from the centres of mass, m.
-  double normal_mass = 0.0;                   ///< 1 / (n·K n), kg.
 };
 
 /// The contact of body a (or the floor, a = kStaticBody) with body b: normal from a to b.
@@ -83,7 +82,7 @@ struct PointRows {
   Vec3 ang_b;          ///< rb × n, m.
   Vec3 inv_a;          ///< I_a⁻¹ (ra × n), 1/(kg·m).
   Vec3 inv_b;          ///< I_b⁻¹ (rb × n), 1/(kg·m).
-  double normal_mass;  ///< 1 / (n·K n), kg (ContactPoint::normal_mass).
+  double normal_mass;  ///< 1 / (n·K n), kg.
   double target;       ///< Normal speed the point must reach (Solver::target_of), m/s.
   double separation;   ///< ContactPoint::separation, m (the split impulse's target).
 };

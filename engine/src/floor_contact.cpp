@@ -422,7 +422,8 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
   auto height = [&](double t) {
     ++evaluations;
     const BodyState st = advance(w.integrator, s, c, w.gravity, t);
-    const double y = (mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask)) - floor_y;
+    const double lowest = mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask);
+    const double y = lowest - floor_y;
     if (y >= 0.0 && t > at_t) at_t = t, at = st;
     return y;
   };

@@ -103,8 +103,6 @@ class Solver {
   void solve_velocity(std::size_t slot);
   /// One split-impulse sweep of rows slot `slot` on the pseudo velocities.
   void solve_position(std::size_t slot, const SolverSettings& s, double dt);
-  /// The solver body of id, or the fixed stand-in for the floor.
-  SolverBody& side(std::uint32_t id) { return id == kStaticBody ? fixed_ : sb_[index_[id]]; }
   /// The solver body at solver index k, or the fixed stand-in for the floor (k < 0).
   SolverBody& at(std::int32_t k) { return k < 0 ? fixed_ : sb_[k]; }
   /// Relative normal velocity of b over a at a point (row r, normal n), m/s. Body: anything
