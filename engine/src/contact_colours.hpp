@@ -18,7 +18,6 @@ struct ContactColours {
   std::vector<std::uint32_t> rank_a;  ///< Contacts of each contact's body a before it.
   std::vector<std::uint32_t> rank_b;  ///< Contacts of each contact's body b before it.
   std::vector<std::uint32_t> degree;  ///< Contacts of each body.
-  std::vector<std::uint32_t> turns;   ///< Scratch of a sweep: contacts each body has taken.
   std::vector<std::uint32_t> latest;  ///< Scratch: one past each body's latest colour.
   std::vector<std::uint32_t> colour;  ///< Scratch: colour of each contact.
   /// Number of colours.

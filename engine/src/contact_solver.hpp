@@ -65,14 +65,22 @@ int floor_contact(const BodyState& s, const BodyConstants& c, std::uint32_t body
 /// from `previous`.
 void warm_start_from(Contact& contact, const Contact& previous);
 
-/// Velocities of a body during the solve (I⁻¹ fixed at the start of the step).
-struct SolverBody {
+/// Velocities of a body during the solve (I⁻¹ fixed at the start of the step). What a
+/// velocity sweep reads and writes of it (v, w, inv_mass, turn) fills its first 64-byte line,
+/// and no two bodies share a line: on several threads a contact then moves one line per body
+/// between cores (the turn that lets it start brings the velocities with it), and a thread
+/// writing one body never evicts a neighbour the other thread holds. Laid out one after
+/// another at 176 bytes, with the turns in an array of their own, `pile`'s contact solve took
+/// 10 % longer on two threads.
+struct alignas(64) SolverBody {
   Vec3 v = Vec3::Zero();            ///< m/s.
   Vec3 w = Vec3::Zero();            ///< rad/s.
+  double inv_mass = 0.0;            ///< 1/kg.
+  /// Contacts of this body a coloured sweep has taken (Solver's sweeps; atomic_ref only).
+  std::uint32_t turn = 0;
   Vec3 vp = Vec3::Zero();           ///< Split-impulse pseudo velocity, m/s.
   Vec3 wp = Vec3::Zero();           ///< Split-impulse pseudo angular velocity, rad/s.
   Mat3 inv_inertia = Mat3::Zero();  ///< World I⁻¹ at the step start, 1/(kg·m²).
-  double inv_mass = 0.0;            ///< 1/kg.
 };
 
 /// One contact point's row along the normal, computed once a step so that the iterations are
