@@ -145,6 +145,10 @@ struct SupportEntry {
   double height;
   std::uint32_t upper;
   std::uint32_t contact;
+  /// On several threads: the solver index of the body under it (−1: the floor) and how many
+  /// earlier solves touch that body (its turn, SolverBody::turn).
+  std::int32_t lower = -1;
+  std::uint32_t lower_turn = 0;
 };
 
 /// The solver's buffers, reused between steps.
@@ -156,6 +160,8 @@ struct SolverScratch {
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
   std::vector<SupportEntry> order;    ///< Shock propagation order.
   std::vector<std::uint32_t> waves, wave_of, wave_start, wave_order;  ///< Its waves.
+  std::vector<std::uint32_t> touches;     ///< Its solves so far that touch each solver body.
+  std::vector<std::uint32_t> upper_turn;  ///< Each solve's turn at the body it holds up.
   std::vector<std::uint32_t> group_start;  ///< Its solves: each body's supports in `order`.
   std::vector<std::int32_t> colour_a, colour_b;  ///< Solver index of each contact's bodies.
   ContactColours colours;                        ///< The contacts grouped by colour.

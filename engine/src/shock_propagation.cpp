@@ -30,7 +30,8 @@ namespace tumble {
 // The sweep is ordered, but a body's solve depends only on the earlier solves that share one
 // of its bodies: each solve's wave is one more than the latest wave of its bodies, and the
 // solves of one wave touch disjoint bodies. Waves run in turn, each shared among the pool's
-// threads: every body sees the same updates in the same order as in the ordered sweep.
+// threads, and a solve starts once its bodies' earlier solves are done (their turns): every
+// body sees the same updates in the same order as in the ordered sweep.
 void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
                                WorkerPool& pool) {
   constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
@@ -68,21 +69,32 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     for (std::size_t gi = 0; gi < groups; ++gi) solve_group(gi);
     return;
   }
+  // Each solve's wave, and its turn at each body it touches (the body it holds up, and those
+  // under it): how many solves before it in height order touch that body.
   waves_.assign(sb_.size(), 0);
+  touches_.assign(sb_.size(), 0);
   wave_of_.resize(groups);
+  upper_turn_.resize(groups);
   std::uint32_t last = 0;
   for (std::size_t gi = 0; gi < groups; ++gi) {
-    std::uint32_t wave = 0;
-    auto each_body = [&](auto&& fn) {
-      for (std::uint32_t k = group_start_[gi]; k < group_start_[gi + 1]; ++k) {
-        const Contact& c = contacts[order[k].contact];
-        if (c.a != kStaticBody) fn(waves_[index_[c.a]]);
-        fn(waves_[index_[c.b]]);
-      }
-    };
-    each_body([&](std::uint32_t w) { wave = std::max(wave, w); });
+    const std::int32_t upper = index_[order[group_start_[gi]].upper];
+    std::uint32_t wave = waves_[upper];
+    for (std::uint32_t k = group_start_[gi]; k < group_start_[gi + 1]; ++k) {
+      SupportEntry& e = order[k];
+      const Contact& c = contacts[e.contact];
+      const std::uint32_t lower = c.a == e.upper ? c.b : c.a;
+      e.lower = lower == kStaticBody ? -1 : index_[lower];
+      if (e.lower >= 0) wave = std::max(wave, waves_[e.lower]);
+    }
     ++wave;
-    each_body([&](std::uint32_t& w) { w = wave; });
+    waves_[upper] = wave;
+    upper_turn_[gi] = touches_[upper]++;
+    for (std::uint32_t k = group_start_[gi]; k < group_start_[gi + 1]; ++k) {
+      SupportEntry& e = order[k];
+      if (e.lower < 0) continue;
+      waves_[e.lower] = wave;
+      e.lower_turn = touches_[e.lower]++;
+    }
     wave_of_[gi] = wave;
     last = std::max(last, wave);
   }
@@ -95,13 +107,30 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     wave_order_[wave_start_[wave_of_[gi]]++] = static_cast<std::uint32_t>(gi);
   for (std::size_t w = wave_start_.size() - 1; w > 0; --w) wave_start_[w] = wave_start_[w - 1];
   wave_start_[0] = 0;
-  // Waves 1 … last are the phases of one job (pool.for_each_phase).
+  // Waves 1 … last are the phases of one job (pool.for_each_phase) without barriers, as the
+  // solver's sweeps run (contact_solver.cpp): a solve waits only for its own bodies' earlier
+  // solves. A barrier per wave held both threads for the slowest chunk of each of `pile`'s
+  // waves.
+  for (SolverBody& b : sb_) b.turn = 0;
+  auto solve_in_turn = [&](std::size_t gi) {
+    const std::span<const SupportEntry> group(order.data() + group_start_[gi],
+                                              order.data() + group_start_[gi + 1]);
+    SolverBody& upper = sb_[index_[group[0].upper]];
+    wait_turn(upper.turn, upper_turn_[gi]);
+    for (const SupportEntry& e : group)
+      if (e.lower >= 0) wait_turn(sb_[e.lower].turn, e.lower_turn);
+    push_up_body(contacts, group, up, dt);
+    pass_turn(upper.turn);
+    for (const SupportEntry& e : group)
+      if (e.lower >= 0) pass_turn(sb_[e.lower].turn);
+  };
   pool.for_each_phase(
       last, 4, [&](std::size_t p) { return wave_start_[p + 2] - wave_start_[p + 1]; },
       [&](std::size_t p, std::size_t from, std::size_t to) {
         const std::size_t begin = wave_start_[p + 1];
-        for (std::size_t k = begin + from; k < begin + to; ++k) solve_group(wave_order_[k]);
-      });
+        for (std::size_t k = begin + from; k < begin + to; ++k) solve_in_turn(wave_order_[k]);
+      },
+      false);
 }
 
 /// Shock propagation of one body on its supports (`group`: (height, contact) entries whose

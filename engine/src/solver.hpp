@@ -40,6 +40,7 @@ class Solver {
         rows_(scratch.rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
         order_(scratch.order), waves_(scratch.waves), wave_of_(scratch.wave_of),
         wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
+        touches_(scratch.touches), upper_turn_(scratch.upper_turn),
         group_start_(scratch.group_start) {
     index_.resize(bodies.size(), -1);
     fixed_ = SolverBody{};
@@ -148,6 +149,8 @@ class Solver {
   std::vector<std::uint32_t>& wave_of_;     // wave of each group
   std::vector<std::uint32_t>& wave_start_;  // start of each wave in wave_order_
   std::vector<std::uint32_t>& wave_order_;  // solves (groups), wave by wave
+  std::vector<std::uint32_t>& touches_;     // solves so far that touch each body
+  std::vector<std::uint32_t>& upper_turn_;  // each solve's turn at its upper body
   std::vector<std::uint32_t>& group_start_;  // start of each body's supports in order_
 };
 
