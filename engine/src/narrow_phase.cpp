@@ -114,11 +114,31 @@ void collide_pairs(StepContext& ctx) {
         s.velocities[awake[k]] = motion_of(ctx.bodies[awake[k]]);
     });
   }
+  // A round after one that woke bodies keeps the earlier round's answer for each pair it
+  // already had (narrow_phase kept its pairs; its manifolds and slots are still here): no
+  // body has moved since, so a manifold found again would be the same, bit for bit. In
+  // `pile` (kept awake as `tumble-bench contact` keeps it) 43 % of the steps have a second
+  // round, which collided every pair again: 30 % of the box–box tests.
+  std::span<const BodyPair> earlier;
+  if (s.earlier_step == ctx.step_index) {
+    earlier = s.earlier_pairs;
+    std::swap(s.earlier_manifolds, s.manifolds);
+    std::swap(s.earlier_slot, s.slot);
+  }
   // Only the manifolds with points are kept (a quarter of `pile`'s pairs).
   s.manifolds.resize(s.pairs.size());
   s.slot.resize(s.pairs.size());
   ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    // Both lists are sorted: one search, then a walk.
+    auto e = std::lower_bound(earlier.begin(), earlier.end(), s.pairs[begin]);
     for (std::size_t k = begin; k < end; ++k) {
+      while (e != earlier.end() && *e < s.pairs[k]) ++e;
+      if (e != earlier.end() && *e == s.pairs[k]) {
+        const auto at = static_cast<std::size_t>(e - earlier.begin());
+        s.slot[k] = s.earlier_slot[at] >= 0 ? 0 : -1;
+        if (s.slot[k] == 0) s.manifolds[k] = s.earlier_manifolds[at];
+        continue;
+      }
       const BoxManifold m = manifold_of(ctx, s.pairs[k], shared);
       s.slot[k] = m.count > 0 ? 0 : -1;
       if (m.count > 0) s.manifolds[k] = m;
@@ -220,6 +240,10 @@ void narrow_phase(StepContext& ctx) {
   collide_pairs(ctx);
   collide_floor(ctx);  // floor contacts, then the box–box ones
   ctx.stats.contacts = static_cast<std::uint32_t>(s.links.size());
+  if (s.woken > 0) {  // another round follows (World::step): it reuses this one's answers
+    std::swap(s.earlier_pairs, s.pairs);  // the broad phase refills the pairs
+    s.earlier_step = ctx.step_index;
+  }
 }
 
 }  // namespace tumble

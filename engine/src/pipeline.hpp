@@ -114,6 +114,12 @@ struct StepScratch {
   std::vector<double> speed;            ///< Point-speed bound of each linked body, m/s.
   std::vector<double> reach;            ///< Fastest neighbour of each body, m/s.
   int woken = 0;                        ///< Sleeping bodies the narrow phase woke.
+  /// The pairs, manifolds and slots of the step's last detection round that woke a body (the
+  /// next round reuses their answers: nothing has moved since), and that step's index.
+  std::vector<BodyPair> earlier_pairs;
+  std::vector<BoxManifold> earlier_manifolds;
+  std::vector<std::int32_t> earlier_slot;
+  std::uint64_t earlier_step = ~std::uint64_t{0};
   IslandScratch island;                 ///< Union–find and island lists.
   std::vector<std::uint32_t> solver_bodies;  ///< Bodies in islands of two or more, ascending.
   std::vector<std::uint32_t> lone_bodies;    ///< Awake bodies touching no other body.
