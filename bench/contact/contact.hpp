@@ -48,7 +48,9 @@ struct Behaviour {
 
 /// One engine on one scene.
 struct EngineResult {
-  std::vector<double> ms;  ///< CPU ms per step, one per repetition.
+  std::vector<double> ms;  ///< CPU ms per step, one per repetition (threaded: wall clock).
+  /// Wall-clock ms per step of the same runs: what a threaded run's speed-up compares.
+  std::vector<double> wall_ms;
   long steps_done = 0;     ///< Fewest steps timed over the repetitions (CPU budget).
   std::string refused;     ///< Why the engine refused or broke in a timed run, else empty.
   Behaviour tower_awake;   ///< Tower only: 60 s kept awake.

@@ -2,6 +2,7 @@
 /// repetition runs every engine in turn on a fresh world), then one untimed behaviour run per
 /// engine. Returns plain structs; writes nothing.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -13,9 +14,10 @@ namespace tumble_bench::contact {
 namespace {
 
 /// CPU seconds per step over `steps` steps of a fresh, kept-awake engine (building it is not
-/// timed); stops early once `budget` CPU seconds are spent (*done: steps actually run).
+/// timed); stops early once `budget` CPU seconds are spent (*done: steps actually run;
+/// *wall: wall-clock seconds per step of the same steps).
 double timed_awake(const Contender& c, const tumble::Scene& s, long steps, double budget,
-                   long* done, std::string* why) {
+                   long* done, double* wall, std::string* why) {
   std::unique_ptr<PeerWorld> e;
   try {
     e = c.make(s, PeerSetup{.stacking = true, .allow_sleep = false});
@@ -23,15 +25,18 @@ double timed_awake(const Contender& c, const tumble::Scene& s, long steps, doubl
     *why = ex.what();
     return NAN;
   }
-  double cpu = 0.0;
+  double cpu = 0.0, elapsed = 0.0;
   long i = 1;
   for (; i <= steps && cpu < budget; ++i) {
     const double t0 = clock_of(c);
+    const auto w0 = std::chrono::steady_clock::now();
     e->keep_awake(i);
     e->step();
+    elapsed += std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
     cpu += clock_of(c) - t0;
   }
   *done = i - 1;
+  *wall = elapsed / static_cast<double>(*done);
   const std::string t = e->trouble();
   if (!t.empty()) *why = t;
   return cpu / static_cast<double>(*done);
@@ -106,9 +111,11 @@ void time_engines(const Measurement& m, const tumble::Scene& s, SceneResult& r, 
     bar.note(r.spec.name + " " + c.name);
     std::string why;
     long done = 0;
-    const double per_step = timed_awake(c, s, r.timed_steps, r.spec.budget, &done, &why);
+    double wall = NAN;
+    const double per_step = timed_awake(c, s, r.timed_steps, r.spec.budget, &done, &wall, &why);
     if (!why.empty()) e.refused = why;
     e.ms.push_back(per_step * 1e3);
+    e.wall_ms.push_back(wall * 1e3);
     e.steps_done = e.ms.size() == 1 ? done : std::min(e.steps_done, done);
   }
 }

@@ -42,8 +42,9 @@ std::vector<Row> rows(const Measurement& m, const SceneResult& r) {
     row.valid = std::isfinite(ms) && trouble.empty();
     row.ms = row.valid || c.name == "tumble" ? ms : NAN;
     row.ratio = c.name == "tumble" ? 1.0 : (row.valid ? ms / tumble_ms : NAN);
-    // A threaded Tumble's ratio is its speed-up: one thread's time / its own.
-    if (c.threads > 1 && row.valid) row.ratio = tumble_ms / ms;
+    // A threaded Tumble's ratio is its speed-up: one thread's time / its own, both by the
+    // wall clock (one thread's CPU time would leave out the machine's noise on its side only).
+    if (c.threads > 1 && row.valid) row.ratio = median(r.engine.at("tumble").wall_ms) / ms;
     const bool tower = r.spec.name == "tower";
     row.tower_drift = tower ? e.tower_awake.drift : NAN;
     // Deepest penetration: the sleeping run, and for the tower the 60 s awake run too.
