@@ -122,9 +122,16 @@ bool settle_lone_body(Body& b, std::uint32_t id, ContactCache& cache, double dt,
 
 // Lone bodies took the rule in flight (settle_lone_body); the islands take it here.
 void update_sleep(StepContext& ctx) {
+  constexpr std::size_t kGrain = 256;  // bodies per chunk: ~20 ns each
   StepScratch& s = ctx.scratch;
-  for (std::uint32_t id : s.solver_bodies)
-    update_still_time(ctx.bodies[id], ctx.cache.anchors[id], ctx.dt, ctx.world);
+  // Each island body's still time on its own, shared among the pool's threads (it writes
+  // only that body's time and anchor); the islands then fall asleep in order.
+  ctx.pool.for_each(s.solver_bodies.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::uint32_t id = s.solver_bodies[k];
+      update_still_time(ctx.bodies[id], ctx.cache.anchors[id], ctx.dt, ctx.world);
+    }
+  });
   for (std::size_t k = 0; k < s.island.count(); ++k) {
     const std::span<const std::uint32_t> members = s.island.island(k);
     bool still = true;
