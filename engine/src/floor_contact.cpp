@@ -419,11 +419,13 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
                       int& evaluations, BodyState& at) {
   double at_t = 0.0;
   at = s;
+  auto height_of = [&](const BodyState& st) {
+    return (mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask)) - floor_y;
+  };
   auto height = [&](double t) {
     ++evaluations;
     const BodyState st = advance(w.integrator, s, c, w.gravity, t);
-    const double lowest = mask == 0xFF ? lowest_vertex_y(st, c) : lowest_masked_y(st, c, mask);
-    const double y = lowest - floor_y;
+    const double y = height_of(st);
     if (y >= 0.0 && t > at_t) at_t = t, at = st;
     return y;
   };
@@ -443,7 +445,9 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
   // TOMS 748 (Alefeld, Potra & Shi 1995) on the lowest-vertex height along the trajectory:
   // cubic inverse interpolation with bracketing, a few evaluations where bisection takes
   // log2(h / tolerance). The lower end keeps the sign of height(0) > 0.
-  const double h0 = height(0.0);
+  // The start is s itself: its height needs no trajectory evaluation (advancing by 0 s
+  // gives s back to the bit).
+  const double h0 = height_of(s);
   std::uintmax_t max_iter = 100;
   const double tol = w.toi_tolerance;
   const auto bracket = boost::math::tools::toms748_solve(
