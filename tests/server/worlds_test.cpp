@@ -215,17 +215,37 @@ TEST_F(IdleWorldsTest, ARequestWakesAnIdleWorld) {
 }
 
 // A world whose request is still running is not idle: a POST /api/step that runs past
-// --idle-remove-s (the landing pile under a 2.5 s step budget) keeps its world, and answers.
+// --idle-remove-s (spinning boxes under a 2.5 s step budget) keeps its world, and answers.
 class WorldsWithBigScenes : public IdleWorldsTest {
+ protected:
   void configure(ServerOptions& o) override {
     IdleWorldsTest::configure(o);
     o.max_bodies = 2000;
     o.step_budget_ms = 2500;  // past --idle-remove-s (1.2 s), within the client's 5 s
   }
+
+  /// 1,000 spinning 1×2×3 m boxes 4 m apart, no gravity and no floor: they never touch and
+  /// never sleep, so every step costs the same (~0.15 ms) and 100,000 steps outlast the step
+  /// budget however fast the engine gets. (The bundled pile falls asleep within ~400 steps;
+  /// its 100,000 steps then took 1.2–1.3 s, too close to --idle-remove-s.)
+  static std::string spinning_boxes() {
+    json bodies = json::array();
+    for (int i = 0; i < 1000; ++i) {
+      bodies.push_back({{"name", "b" + std::to_string(i)},
+                        {"size", {1, 2, 3}},
+                        {"position", {4.0 * (i % 10), 4.0 * (i / 10 % 10), 4.0 * (i / 100)}},
+                        {"angular_velocity", {0.3 + 0.001 * i, 1.0, -0.5}}});
+    }
+    return json{{"name", "spinning"}, {"gravity", {0, 0, 0}}, {"floor", nullptr},
+                {"dt", 1.0 / 60.0},   {"bodies", bodies}}
+        .dump();
+  }
 };
 
 TEST_F(WorldsWithBigScenes, ALongRequestKeepsItsWorld) {
-  const std::string token = create("busy", "pile");
+  const HttpReply created = put("busy", spinning_boxes());
+  ASSERT_EQ(created.status, 201u) << created.body;
+  const std::string token = created.json().value("token", "");
   ASSERT_EQ(post("busy", "pause", token).status, 200u);
   const auto t0 = std::chrono::steady_clock::now();
   const HttpReply r = post("busy", "step", token, R"({"steps": 100000})");
