@@ -372,7 +372,7 @@ Jacobi periodic_flow(const Polhode& p, double tau, double& bracket) {
 // where they are L/M, (m0[1] c1 − m0[0] c2)/ρ (c_i = R0 Cᵀ ê_i, columns of R0 up to sign) and
 // the cross product of those two. That replaces building P(m0) and one of the three 3×3
 // products, and the signed permutation C is applied to the columns of P(m(t)) instead of to
-// R0 and to the result: 11 % fewer instructions a step than R0 Cᵀ · (P(m0)ᵀ · Rz P(m(t))).
+// R0 and to the result: 11 % fewer instructions a call than R0 Cᵀ · (P(m0)ᵀ · Rz P(m(t))).
 // The second row is taken from m0's components, as P(m0) did, not as (L × c3)/ρ: near a
 // steady spin ρ is round-off small, and only m0's own components give it the direction
 // that P(m(t)) continues.
@@ -399,6 +399,8 @@ Mat3 elliptic_flow(const Vec3& m0, double J1, double J2, double J3, double D1, d
   w.col(0) = cos_psi * w1 + sin_psi * w2;
   w.col(1) = cos_psi * w2 - sin_psi * w1;
   w.col(2) = w3;
+  // |m(t)| = M up to round-off. Normalising by |m(t)| itself puts a square root and a
+  // division more at the end of the chain: 20 ns a call (docs/engine.md, "Tried").
   const Mat3 p1 = momentum_frame(p.momentum(f), inv_M);
   Mat3 p1c;  // P(m(t)) C: columns back on the body axes
   for (int i = 0; i < 3; ++i) p1c.col(perm[i]) = sgn[i] * p1.col(i);
@@ -432,7 +434,8 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   const double D2 = q1 * (J1 - J2) + q3 * (J3 - J2);  // M² − 2E J2
 
   if (D3 / (J3 - J1) <= 0.0 || m0[0] * m0[0] + m0[1] * m0[1] == 0.0) {
-    // Steady spin about canonical axis 3, which is body axis perm[2] turned by sgn[2].
+    // Steady spin about canonical axis 3, that is sgn[2] times body axis perm[2]: a turn
+    // about body axis perm[2] by t mb[perm[2]] / J3 (mb[perm[2]] = sgn[2] m0[2]).
     return R * axis_rotation(perm[2], t * mb[perm[2]] / J3);
   }
   return elliptic_flow(m0, J1, J2, J3, D1, D2, D3, t, R, L, perm, sgn);
