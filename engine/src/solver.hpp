@@ -78,9 +78,12 @@ class Solver {
   /// Puts the accumulated impulses of rows slot `slot` back into its contact c.
   void store_impulses(Contact& c, std::size_t slot) const;
 
-  /// The collision pass of contact c: its fast-approaching points' exact impulses; 1 when it
-  /// had an impact, else 0.
-  int impact(Contact& c, const Vec3& gravity, double dt);
+  /// The collision pass of contact c (rows slot `slot`): its fast-approaching points' exact
+  /// impulses; 1 when it had an impact, else 0.
+  int impact(Contact& c, std::size_t slot, const Vec3& gravity, double dt);
+  /// False when no point of rows slot `slot` approaches faster than `threshold` (m/s) by
+  /// more than round-off: the collision pass has nothing to do.
+  bool may_be_fast(std::size_t slot, double threshold);
   /// The ground-up pass over the contacts after the iterations (shock_propagation.cpp).
   void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
                          WorkerPool& pool);
