@@ -29,6 +29,32 @@ TEST_F(HttpSessionTest, ServesIndexAndFilesWithMimeTypes) {
   EXPECT_EQ(r.headers[http::field::content_length], "36");
 }
 
+// A current copy is revalidated: 304, no body, the validators and the cross-origin isolation
+// headers kept, and no Content-Type (the cached copy's stands; RFC 9110 §15.4.5). A tag that
+// does not match gets the file again.
+TEST_F(HttpSessionTest, ACurrentCopyGets304WithoutBody) {
+  const HttpReply first = http_get(port_, "/src/main.mjs");
+  ASSERT_EQ(first.status, 200u);
+  const std::string etag(first.headers[http::field::etag]);
+  ASSERT_FALSE(etag.empty());
+  const auto get_if_none_match = [&](const std::string& tag) {
+    return raw_request(port_, "GET /src/main.mjs HTTP/1.1\r\nHost: 127.0.0.1\r\nIf-None-Match: " +
+                                  tag + "\r\n\r\n");
+  };
+  HttpReply r = get_if_none_match(etag);
+  EXPECT_EQ(r.status, 304u);
+  EXPECT_EQ(r.body, "");
+  EXPECT_EQ(r.headers[http::field::etag], etag);
+  EXPECT_EQ(r.headers[http::field::cache_control], "no-cache");
+  EXPECT_EQ(r.headers["Cross-Origin-Embedder-Policy"], "require-corp");
+  EXPECT_EQ(r.headers["Cross-Origin-Opener-Policy"], "same-origin");
+  EXPECT_EQ(r.headers.count(http::field::content_type), 0u);
+  r = get_if_none_match("\"0-0-0\"");
+  EXPECT_EQ(r.status, 200u);
+  EXPECT_EQ(r.body, first.body);
+  EXPECT_EQ(r.headers[http::field::content_type], "text/javascript; charset=utf-8");
+}
+
 TEST_F(HttpSessionTest, RefusesPathTraversal) {
   for (const std::string target :
        {"/../secret.txt", "/%2e%2e/secret.txt", "/%2E%2e/%2e%2E/etc/passwd", "/..%2Fsecret.txt",
