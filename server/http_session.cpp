@@ -284,7 +284,10 @@ void HttpSession::send_file(const Request& req, beast::file file, const StaticLo
   const std::string gzip_tag = identity_tag.substr(0, identity_tag.size() - 1) + "-gz\"";
   const std::string_view if_none_match = req[http::field::if_none_match];
   const auto headers = [&](auto& res, const std::string& etag) {
-    res.set(http::field::content_type, type);
+    // A 304 carries no representation metadata (RFC 9110 §15.4.5): the client keeps the
+    // cached copy's Content-Type. A repeat visit of the page revalidates ~26 files, and the
+    // header was ~1.2 KB of its 10 KB.
+    if (res.result() != http::status::not_modified) res.set(http::field::content_type, type);
     res.set(http::field::cache_control, "no-cache");
     res.set(http::field::etag, etag);
     // Cross-origin isolation: the page may then share memory with its stream worker.
@@ -296,10 +299,6 @@ void HttpSession::send_file(const Request& req, beast::file file, const StaticLo
   if (etag_matches(if_none_match, identity_tag) || etag_matches(if_none_match, gzip_tag)) {
     http::response<http::empty_body> res{http::status::not_modified, req.version()};
     headers(res, gzip ? gzip_tag : identity_tag);
-    // A 304 carries no representation metadata (RFC 9110 §15.4.5): the client keeps the
-    // cached copy's Content-Type. A repeat visit of the page revalidates ~26 files, and the
-    // header was ~1.2 KB of its 10 KB.
-    res.erase(http::field::content_type);
     return send(std::move(res));
   }
   std::shared_ptr<const std::string> packed;
