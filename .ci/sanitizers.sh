@@ -11,8 +11,8 @@
 # (CMake merges each target's sources, eight to a file, so the Beast and Asio templates the
 # server and its tests share are compiled once per batch instead of once per file) with line
 # tables only for debug information (CMAKE_CXX_FLAGS_DEBUG: what a sanitizer's stack trace
-# prints): the two builds took 7.4 min instead of 17.3 in clean-clone CI on 2 cores. The release preset stays
-# one object per source, so each file still compiles on its own.
+# prints): the two builds took 7.4 min instead of 17.3 in clean-clone CI on 2 cores. The
+# release preset stays one object per source, so each file still compiles on its own.
 # Any sanitizer report fails the run (halt_on_error / -fno-sanitize-recover), so does any crash
 # or leak found by a fuzzer; bench and e2e are neither built nor run.
 set -euo pipefail
