@@ -31,10 +31,11 @@ std::vector<Spec> specs(bool quick) {
           {"landing" + cubes, [n] { return landing_cubes(n); }, quick ? 60 : 480, false}};
 }
 
-/// One repetition of one scene: totals in ns (wall, CPU, per stage).
+/// One repetition of one scene: totals in ns (wall, CPU, per stage, per contact-solve pass).
 struct Totals {
   double wall_ns = 0.0, cpu_ns = 0.0;
   std::array<double, tumble::kStageCount> stage_ns{};
+  std::array<double, tumble::kSolvePassCount> pass_ns{};
 };
 
 Totals run_once(const Spec& spec, const tumble::Scene& scene) {
@@ -53,6 +54,8 @@ Totals run_once(const Spec& spec, const tumble::Scene& scene) {
                      .count();
     for (int s = 0; s < tumble::kStageCount; ++s)
       t.stage_ns[s] += static_cast<double>(w.last_step().stage_ns[s]);
+    for (int p = 0; p < tumble::kSolvePassCount; ++p)
+      t.pass_ns[p] += static_cast<double>(w.last_step().solve_pass_ns[p]);
   }
   return t;
 }
@@ -72,6 +75,11 @@ SceneStages summarize(const Spec& spec, std::size_t bodies, const std::vector<To
     for (const Totals& t : runs) v.push_back(t.stage_ns[s] * per_step_us);
     r.stage_us[s] = median(v);
     r.stage_sum_us += r.stage_us[s];
+  }
+  for (int p = 0; p < tumble::kSolvePassCount; ++p) {
+    std::vector<double> v;
+    for (const Totals& t : runs) v.push_back(t.pass_ns[p] * per_step_us);
+    r.pass_us[p] = median(v);
   }
   return r;
 }

@@ -1,4 +1,5 @@
-/// stages, record: stages.csv (one row per scene, one column per stage) and headline values.
+/// stages, record: stages.csv (one row per scene, one column per stage and per contact-solve
+/// pass) and headline values.
 #include <iostream>
 
 #include "report.hpp"
@@ -18,11 +19,16 @@ fs::path record(const Options& o, const Measurement& m) {
                                    "step_cpu_us", "stage_sum_us"};
   for (int s = 0; s < tumble::kStageCount; ++s)
     columns.push_back(std::string(tumble::stage_name(static_cast<tumble::Stage>(s))) + "_us");
+  for (int p = 0; p < tumble::kSolvePassCount; ++p)
+    columns.push_back("solve_" +
+                      std::string(tumble::solve_pass_name(static_cast<tumble::SolvePass>(p))) +
+                      "_us");
   Csv out(path, columns);
   for (const SceneStages& r : m.scenes) {
     out.row() << r.scene << r.bodies << r.steps << (r.kept_awake ? 1 : 0) << r.step_us
               << r.step_cpu_us << r.stage_sum_us;
     for (double us : r.stage_us) out << us;
+    for (double us : r.pass_us) out << us;
     std::cerr << "  " << r.scene << ": " << fmt(r.step_us) << " µs per step (wall), stages sum "
               << fmt(r.stage_sum_us) << " µs\n";
     const std::string k = "stages." + key_of(r) + ".";

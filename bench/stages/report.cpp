@@ -52,6 +52,32 @@ std::string stage_table(const Measurement& m) {
          md_table(header, rows);
 }
 
+/// The contact solve's passes, for the scenes that have contacts to solve.
+std::string pass_table(const Measurement& m) {
+  if (!m.available) return "";
+  const int solve = static_cast<int>(tumble::Stage::contact_solve);
+  std::vector<const SceneStages*> solved;
+  for (const SceneStages& s : m.scenes)
+    if (s.stage_us[solve] > 0.0 && s.stage_us[solve] >= 0.05 * s.step_us) solved.push_back(&s);
+  if (solved.empty()) return "";
+  std::vector<std::string> header{"pass of `contact_solve`"};
+  for (const SceneStages* s : solved) header.push_back(s->scene + ": µs per step (%)");
+  std::vector<std::vector<std::string>> rows;
+  for (int p = 0; p < tumble::kSolvePassCount; ++p) {
+    std::vector<std::string> row{
+        "`" + std::string(tumble::solve_pass_name(static_cast<tumble::SolvePass>(p))) + "`"};
+    for (const SceneStages* s : solved) row.push_back(cell(s->pass_us[p], s->step_us));
+    rows.push_back(row);
+  }
+  std::vector<std::string> stage{"the whole stage"};
+  for (const SceneStages* s : solved) stage.push_back(cell(s->stage_us[solve], s->step_us));
+  rows.push_back(stage);
+  return "The contact solve's passes (`tumble::SolvePass`, timed into "
+         "`StepStats::solve_pass_ns`), in the scenes where the stage takes 5 % of the step "
+         "or more; µs per step and share of the measured step:\n\n" +
+         md_table(header, rows);
+}
+
 }  // namespace
 
 void report(const Options& o, const Measurement& m, const fs::path& csv) {
@@ -65,6 +91,7 @@ void report(const Options& o, const Measurement& m, const fs::path& csv) {
       {"csv", file_link(o, csv)},
       {"scenes_table", scenes_table(m)},
       {"stage_table", stage_table(m)},
+      {"pass_table", pass_table(m)},
   };
   write_section(o, "stages", fill_template("stages", f));
 }

@@ -1,7 +1,8 @@
 #pragma once
-/// stages: where the time of World::step goes, per stage (tumble::Stage), on the contact
-/// scenes (tower, pyramid, pile, kept awake) and the throughput and landing scenes. Sums
-/// World::last_step().stage_ns over the steps and sets it against the measured step time.
+/// stages: where the time of World::step goes, per stage (tumble::Stage) and per pass of the
+/// contact solve (tumble::SolvePass), on the contact scenes (tower, pyramid, pile, kept awake)
+/// and the throughput and landing scenes. Sums World::last_step().stage_ns and solve_pass_ns
+/// over the steps and sets them against the measured step time.
 /// Split in measure (plain structs), record (stages.csv, headline values) and report
 /// (bench/text/stages.md). Single-threaded.
 #include <array>
@@ -26,6 +27,8 @@ struct SceneStages {
   double step_cpu_us = NAN;              ///< CPU time of World::step, µs per step.
   std::array<double, tumble::kStageCount> stage_us{};  ///< µs per step, by tumble::Stage.
   double stage_sum_us = 0.0;             ///< Sum of stage_us.
+  /// µs per step of each pass of the contact_solve stage, by tumble::SolvePass.
+  std::array<double, tumble::kSolvePassCount> pass_us{};
 };
 
 /// A stages run.

@@ -54,14 +54,17 @@ void keep_for_warm_start(StepContext& ctx) {
 
 void contact_solve(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
+  PassClock clock(ctx.timed ? ctx.stats.solve_pass_ns.data() : nullptr);
   if (!s.contacts.empty()) {
     warm_start(ctx);
+    clock.lap(SolvePass::cache);
     ctx.stats.impacts += static_cast<std::uint32_t>(
         solve_contacts(ctx.bodies, s.solver_bodies, s.contacts, ctx.world.gravity, ctx.dt,
-                       SolverSettings{}, s.solver, ctx.pool));
+                       SolverSettings{}, s.solver, ctx.pool, clock));
     ctx.stats.colours = static_cast<std::uint32_t>(s.solver.colours.count());
   }
   keep_for_warm_start(ctx);
+  clock.lap(SolvePass::cache);
 }
 
 }  // namespace tumble

@@ -434,7 +434,8 @@ bool deeper_than(const Contact& c, double slop) {
 // contacts colour by colour, which replays the sweep in contact order that one thread runs.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
-                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool) {
+                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool,
+                   PassClock& clock) {
   constexpr std::size_t kBodyGrain = 128;
   Solver solver(bodies, solver_bodies, scratch, pool, dt * gravity);
   ContactColours& colours = scratch.colours;
@@ -453,6 +454,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
     colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), colours);
     if (contacts.size() < kShared * colours.count()) colours.offset.clear();
   }
+  clock.lap(SolvePass::setup);
   // Rows slot k holds the contact the sweeps meet k-th: colour by colour, else contact order.
   const bool coloured = colours.count() > 0;
   auto contact_at = [&](std::size_t slot) { return coloured ? colours.order[slot] : slot; };
@@ -470,11 +472,14 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
     }
     if (any) deep.store(true, std::memory_order_relaxed);
   });
+  clock.lap(SolvePass::rows);
   std::atomic<int> impacts{0};
   sweep(scratch, contacts, pool, [&](Contact& c, std::size_t slot) {
     if (solver.impact(c, slot, gravity, dt)) impacts.fetch_add(1, std::memory_order_relaxed);
   });
+  clock.lap(SolvePass::impacts);
   sweep(scratch, contacts, pool, [&](Contact&, std::size_t slot) { solver.warm_start(slot); });
+  clock.lap(SolvePass::warm_start);
   sweep(scratch, contacts, pool, [&](Contact&, std::size_t slot) { solver.solve_velocity(slot); },
         settings.velocity_iterations);
   // Shock propagation and the next step's warm start read the impulses in the contacts.
@@ -482,7 +487,9 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
     for (std::size_t slot = begin; slot < end; ++slot)
       solver.store_impulses(contacts[contact_at(slot)], slot);
   });
+  clock.lap(SolvePass::velocity);
   if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt, pool);
+  clock.lap(SolvePass::shock_propagation);
   // The split impulse starts from zero pseudo velocities and only pushes: while no point is
   // deeper than the slop every target is ≤ 0 and every sweep would leave all of them zero (a
   // resting stack: `pyramid` spent 6 % of its instructions proving that).
@@ -490,9 +497,11 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
     sweep(scratch, contacts, pool,
           [&](Contact&, std::size_t slot) { solver.solve_position(slot, settings, dt); },
           settings.position_iterations);
+  clock.lap(SolvePass::split_impulse);
   pool.for_each(solver_bodies.size(), kBodyGrain,
                 [&](std::size_t begin, std::size_t end) { solver.finish(begin, end); });
   solver.release();
+  clock.lap(SolvePass::finish);
   return impacts.load();
 }
 

@@ -4,6 +4,7 @@
 /// starting and Coulomb friction, then split-impulse position correction.
 /// Pure functions over the caller's buffers; thread-safe.
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "active_set.hpp"
 #include "contact_colours.hpp"
 #include "tumble/body.hpp"
+#include "tumble/step_stats.hpp"
 
 namespace tumble {
 
@@ -169,6 +171,28 @@ struct SolverScratch {
 
 class WorkerPool;
 
+/// Charges the wall time between laps to the contact solve's passes (StepStats::solve_pass_ns)
+/// when the World times its stages; otherwise reads no clock. The owner's thread only.
+class PassClock {
+ public:
+  /// Adds into `ns` (kSolvePassCount counters, by SolvePass); null: times nothing.
+  explicit PassClock(std::uint64_t* ns) : ns_(ns) {
+    if (ns_) last_ = std::chrono::steady_clock::now();
+  }
+  /// Adds the time since the last lap (or since construction) to `pass`.
+  void lap(SolvePass pass) {
+    if (!ns_) return;
+    const auto now = std::chrono::steady_clock::now();
+    ns_[static_cast<int>(pass)] += static_cast<std::uint64_t>(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  std::uint64_t* ns_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
 /// Solves the velocities of `bodies[solver_bodies]` over dt under gravity with the contacts:
 /// impacts (relative normal speed above the restitution threshold) get an exact simultaneous
 /// impulse per contact with restitution e; then sequential impulses with warm starting and
@@ -176,9 +200,11 @@ class WorkerPool;
 /// velocities that remove deep penetration. Writes the bodies' end-of-step momenta P, L (their
 /// positions are flight's job) and leaves v, w, vp, wp in scratch.bodies. Returns the number
 /// of impacts. Contacts of one colour (contact_colours.hpp) are solved at the same time on the
-/// threads of `pool`; the result does not depend on their number.
+/// threads of `pool`; the result does not depend on their number. Each pass's time goes to
+/// `clock`.
 int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver_bodies,
                    std::span<Contact> contacts, const Vec3& gravity, double dt,
-                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool);
+                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool,
+                   PassClock& clock);
 
 }  // namespace tumble

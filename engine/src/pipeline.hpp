@@ -139,6 +139,7 @@ struct StepContext {
   StepScratch& scratch;      ///< This step's buffers.
   StepStats& stats;          ///< This step's counters.
   WorkerPool& pool;          ///< Threads for the stages' independent work (1: inline).
+  bool timed = false;        ///< The World times its stages (and the contact solve's passes).
 };
 
 /// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island); called

@@ -66,7 +66,7 @@ World::World(Scene scene) : scene_(std::move(scene)) {
 void World::prime_broad_phase() {
   StepStats unused;
   StepContext ctx{scene_.world, scene_.world.dt, steps_, bodies_, *cache_,
-                  *broad_,      *scratch_,       unused, *pool_};
+                  *broad_,      *scratch_,       unused, *pool_, false};
   broad_phase(ctx);
   scratch_->pairs.clear();
 }
@@ -100,7 +100,7 @@ void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0)) throw InvalidInput("dt must be finite and > 0");
   last_ = {};
   StepContext ctx{scene_.world, dt,       steps_, bodies_, *cache_,
-                  *broad_,       *scratch_, last_,  *pool_};
+                  *broad_,       *scratch_, last_,  *pool_,  time_stages_};
   const WorkerPool::Busy busy(*pool_);  // workers poll through the step's serial stretches
   for (int round = 0; round < kMaxWakeRounds; ++round) {
     run_stage(Stage::broad_phase, broad_phase, ctx, time_stages_);

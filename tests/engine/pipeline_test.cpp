@@ -70,12 +70,32 @@ TEST(Pipeline, StageTimesOnlyWhenAskedFor) {
   World world(bundled("pyramid"));
   world.step();
   for (std::uint64_t ns : world.last_step().stage_ns) EXPECT_EQ(ns, 0u);
+  for (std::uint64_t ns : world.last_step().solve_pass_ns) EXPECT_EQ(ns, 0u);
   world.set_stage_timing(true);
   world.step();
   const StepStats& s = world.last_step();
   EXPECT_GT(s.stage_ns[static_cast<int>(Stage::contact_solve)], 0u);
   EXPECT_GT(s.stage_ns[static_cast<int>(Stage::narrow_phase)], 0u);
   EXPECT_STREQ(stage_name(Stage::contact_solve), "contact_solve");
+}
+
+// The contact solve's passes split its stage time: each pass that has work on a resting
+// pyramid is timed, and together they fit inside the stage (the stage's own clock reads
+// bracket them).
+TEST(Pipeline, ContactSolvePassesSplitItsStageTime) {
+  World world(bundled("pyramid"));
+  world.set_stage_timing(true);
+  for (int i = 0; i < 3; ++i) world.step();
+  const StepStats& s = world.last_step();
+  std::uint64_t sum = 0;
+  for (SolvePass pass : {SolvePass::cache, SolvePass::rows, SolvePass::impacts,
+                         SolvePass::warm_start, SolvePass::velocity,
+                         SolvePass::shock_propagation, SolvePass::finish})
+    EXPECT_GT(s.solve_pass_ns[static_cast<int>(pass)], 0u) << solve_pass_name(pass);
+  for (std::uint64_t ns : s.solve_pass_ns) sum += ns;
+  EXPECT_LE(sum, s.stage_ns[static_cast<int>(Stage::contact_solve)]);
+  EXPECT_GT(sum, s.stage_ns[static_cast<int>(Stage::contact_solve)] / 2);
+  EXPECT_STREQ(solve_pass_name(SolvePass::shock_propagation), "shock_propagation");
 }
 
 // A copy starts without the broad-phase acceleration and the scratch buffers; the results do

@@ -27,6 +27,31 @@ constexpr const char* stage_name(Stage stage) {
   return names[static_cast<int>(stage)];
 }
 
+/// The passes of the contact_solve stage, in the order they run (engine/src/contact_solve.cpp
+/// and contact_solver.cpp).
+enum class SolvePass : std::uint8_t {
+  cache,              ///< Last step's impulses matched to this step's contacts, and kept.
+  setup,              ///< The solver bodies' velocities and, on several threads, the colours.
+  rows,               ///< Each contact's rows (Solver::prepare).
+  impacts,            ///< The collision pass: exact impulses of fast-approaching points.
+  warm_start,         ///< The kept impulses applied to the bodies.
+  velocity,           ///< The sequential-impulse sweeps, and their impulses stored.
+  shock_propagation,  ///< The ground-up pass with the supports held fixed.
+  split_impulse,      ///< The pseudo velocities that remove deep penetration.
+  finish,             ///< The end-of-step momenta written back to the bodies.
+};
+
+/// Number of contact-solve passes.
+inline constexpr int kSolvePassCount = 9;
+
+/// Short lower-case name of a pass ("rows", …), for tables and CSV columns.
+constexpr const char* solve_pass_name(SolvePass pass) {
+  constexpr std::array<const char*, kSolvePassCount> names{
+      "cache",    "setup",     "rows", "impacts", "warm_start", "velocity", "shock_propagation",
+      "split_impulse", "finish"};
+  return names[static_cast<int>(pass)];
+}
+
 /// What the last step did (cheap counters, for benchmarks and metrics).
 struct StepStats {
   std::uint32_t impacts = 0;         ///< Impacts resolved (floor and body–body).
@@ -44,6 +69,9 @@ struct StepStats {
   std::uint32_t pair_budget_exceeded = 0;
   /// Wall time of each stage (steady clock), ns, indexed by Stage.
   std::array<std::uint64_t, kStageCount> stage_ns{};
+  /// Wall time of each pass of the contact_solve stage (steady clock), ns, indexed by
+  /// SolvePass; their sum is that stage's time less a few clock reads.
+  std::array<std::uint64_t, kSolvePassCount> solve_pass_ns{};
 };
 
 }  // namespace tumble
