@@ -47,8 +47,8 @@ inline constexpr int kSolvePassCount = 9;
 /// Short lower-case name of a pass ("rows", …), for tables and CSV columns.
 constexpr const char* solve_pass_name(SolvePass pass) {
   constexpr std::array<const char*, kSolvePassCount> names{
-      "cache",    "setup",     "rows", "impacts", "warm_start", "velocity", "shock_propagation",
-      "split_impulse", "finish"};
+      "cache",    "setup",             "rows",          "impacts", "warm_start",
+      "velocity", "shock_propagation", "split_impulse", "finish"};
   return names[static_cast<int>(pass)];
 }
 
