@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "active_set.hpp"
@@ -160,6 +161,9 @@ struct SolverScratch {
   std::vector<ContactRows> rows;      ///< Solver rows of each contact, in sweep order.
   std::vector<ContactImpulses> impulses;  ///< Impulses of each contact, in sweep order.
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
+  std::vector<SupportEntry> supports; ///< Shock propagation's entry of each contact.
+  std::vector<std::uint32_t> support_start;  ///< Its buckets of entries, one per body.
+  std::vector<std::pair<double, std::uint32_t>> support_keys;  ///< (height, body) to sort.
   std::vector<SupportEntry> order;    ///< Shock propagation order.
   std::vector<std::uint32_t> waves, wave_of, wave_start, wave_order;  ///< Its waves.
   std::vector<std::uint32_t> touches;     ///< Its solves so far that touch each solver body.

@@ -38,8 +38,9 @@ class Solver {
          WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
         rows_(scratch.rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
-        order_(scratch.order), waves_(scratch.waves), wave_of_(scratch.wave_of),
-        wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
+        supports_(scratch.supports), support_start_(scratch.support_start),
+        support_keys_(scratch.support_keys), order_(scratch.order), waves_(scratch.waves),
+        wave_of_(scratch.wave_of), wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
         touches_(scratch.touches), upper_turn_(scratch.upper_turn),
         group_start_(scratch.group_start) {
     index_.resize(bodies.size(), -1);
@@ -147,6 +148,9 @@ class Solver {
   std::vector<ContactRows>& rows_;  // solver rows of each contact
   std::vector<ContactImpulses>& impulses_;  // their impulses during the velocity passes
   SolverBody& fixed_;               // the floor: absorbs impulses without moving
+  std::vector<SupportEntry>& supports_;  // shock propagation's entry of each contact
+  std::vector<std::uint32_t>& support_start_;  // its buckets, one per solver body
+  std::vector<std::pair<double, std::uint32_t>>& support_keys_;  // (height, body) to sort
   std::vector<SupportEntry>& order_;
   std::vector<std::uint32_t>& waves_;       // latest shock-propagation wave of each body
   std::vector<std::uint32_t>& wave_of_;     // wave of each group
