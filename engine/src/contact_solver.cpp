@@ -397,7 +397,10 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
   }
   const std::size_t count = colours.count();
   const std::span<SolverBody> sb(scratch.bodies);
-  for (SolverBody& body : sb) body.turn = 0;  // the turns count this sweep's passes
+  // The turns go on counting from the solve's earlier passes (turn_base): zeroing them here,
+  // on the owner's thread, pulled every body's line from the core that last wrote it (~40 µs
+  // of `pile`'s step on two threads, in five passes, while the other thread waited).
+  const std::span<const std::uint32_t> base(scratch.turn_base);
   pool.for_each_phase(
       count * static_cast<std::size_t>(passes), kGrain,
       [&](std::size_t phase) { return colours.of(phase % count).size(); },
@@ -407,14 +410,18 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
         for (std::size_t slot = start + begin; slot < start + end; ++slot) {
           const std::uint32_t k = colours.order[slot];
           const std::int32_t a = scratch.colour_a[k], b = scratch.colour_b[k];
-          if (a >= 0) wait_turn(sb[a].turn, pass * colours.degree[a] + colours.rank_a[k]);
-          if (b >= 0) wait_turn(sb[b].turn, pass * colours.degree[b] + colours.rank_b[k]);
+          if (a >= 0)
+            wait_turn(sb[a].turn, base[a] + pass * colours.degree[a] + colours.rank_a[k]);
+          if (b >= 0)
+            wait_turn(sb[b].turn, base[b] + pass * colours.degree[b] + colours.rank_b[k]);
           fn(contacts[k], slot);
           if (a >= 0) pass_turn(sb[a].turn);
           if (b >= 0) pass_turn(sb[b].turn);
         }
       },
       false);
+  for (std::size_t i = 0; i < sb.size(); ++i)
+    scratch.turn_base[i] += static_cast<std::uint32_t>(passes) * colours.degree[i];
 }
 
 /// True when some point of contact c penetrates deeper than `slop` (m).

@@ -170,6 +170,10 @@ struct SolverScratch {
   std::vector<std::uint32_t> upper_turn;  ///< Each solve's turn at the body it holds up.
   std::vector<std::uint32_t> group_start;  ///< Its solves: each body's supports in `order`.
   std::vector<std::int32_t> colour_a, colour_b;  ///< Solver index of each contact's bodies.
+  /// Each solver body's turns taken so far in this solve (SolverBody::turn is zeroed once, in
+  /// parallel, when the solve starts): a sweep or shock propagation waits for turns counted
+  /// from there.
+  std::vector<std::uint32_t> turn_base;
   ContactColours colours;                        ///< The contacts grouped by colour.
 };
 

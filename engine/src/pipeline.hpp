@@ -107,6 +107,7 @@ struct StepScratch {
   std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
   std::vector<std::int32_t> slot;       ///< Position of each pair's box–box contact, or −1.
   std::vector<std::int32_t> floor_slot; ///< Position of each linked body's floor contact, or −1.
+  std::vector<std::uint32_t> slot_counts;  ///< Marked slots per range (number_slots).
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<std::uint8_t> marked;     ///< Scratch of `linked`: body is in a box–box contact.
   std::vector<BodyPair> links;          ///< Body pairs of the box–box contacts.

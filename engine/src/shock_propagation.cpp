@@ -136,14 +136,15 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   // solver's sweeps run (contact_solver.cpp): a solve waits only for its own bodies' earlier
   // solves. A barrier per wave held both threads for the slowest chunk of each of `pile`'s
   // waves.
-  for (SolverBody& b : sb_) b.turn = 0;
+  // The turns count on from the solve's sweeps (turn_base_), as theirs do.
   auto solve_in_turn = [&](std::size_t gi) {
     const std::span<const SupportEntry> group(order.data() + group_start_[gi],
                                               order.data() + group_start_[gi + 1]);
-    SolverBody& upper = sb_[index_[group[0].upper]];
-    wait_turn(upper.turn, upper_turn_[gi]);
+    const std::int32_t u = index_[group[0].upper];
+    SolverBody& upper = sb_[u];
+    wait_turn(upper.turn, turn_base_[u] + upper_turn_[gi]);
     for (const SupportEntry& e : group)
-      if (e.lower >= 0) wait_turn(sb_[e.lower].turn, e.lower_turn);
+      if (e.lower >= 0) wait_turn(sb_[e.lower].turn, turn_base_[e.lower] + e.lower_turn);
     push_up_body(contacts, group, up, dt);
     pass_turn(upper.turn);
     for (const SupportEntry& e : group)
@@ -156,6 +157,7 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
         for (std::size_t k = begin + from; k < begin + to; ++k) solve_in_turn(wave_order_[k]);
       },
       false);
+  for (std::size_t k = 0; k < sb_.size(); ++k) turn_base_[k] += touches_[k];
 }
 
 /// Shock propagation of one body on its supports (`group`: (height, contact) entries whose

@@ -41,11 +41,12 @@ class Solver {
         supports_(scratch.supports), support_start_(scratch.support_start),
         support_keys_(scratch.support_keys), order_(scratch.order), waves_(scratch.waves),
         wave_of_(scratch.wave_of), wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
-        touches_(scratch.touches), upper_turn_(scratch.upper_turn),
+        touches_(scratch.touches), turn_base_(scratch.turn_base), upper_turn_(scratch.upper_turn),
         group_start_(scratch.group_start) {
     index_.resize(bodies.size(), -1);
     fixed_ = SolverBody{};
     sb_.resize(ids.size());
+    turn_base_.assign(ids.size(), 0);
     pool.for_each(ids.size(), 128, [&](std::size_t begin, std::size_t end) {
       for (std::size_t k = begin; k < end; ++k) {
         const Body& b = bodies[ids[k]];
@@ -157,6 +158,7 @@ class Solver {
   std::vector<std::uint32_t>& wave_start_;  // start of each wave in wave_order_
   std::vector<std::uint32_t>& wave_order_;  // solves (groups), wave by wave
   std::vector<std::uint32_t>& touches_;     // solves so far that touch each body
+  std::vector<std::uint32_t>& turn_base_;   // turns each body took earlier in the solve
   std::vector<std::uint32_t>& upper_turn_;  // each solve's turn at its upper body
   std::vector<std::uint32_t>& group_start_;  // start of each body's supports in order_
 };
