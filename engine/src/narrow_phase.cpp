@@ -79,18 +79,23 @@ std::uint32_t number_slots(std::vector<std::int32_t>& slot, std::vector<std::uin
                            WorkerPool& pool) {
   constexpr std::size_t kRange = 1024;  // marks per range
   const std::size_t n = slot.size();
-  counts.assign((n + kRange - 1) / kRange, 0);
+  counts.resize((n + kRange - 1) / kRange);
+  // Each range counts into a local and writes its count once: neighbouring counts share a
+  // cache line between the threads.
   pool.for_each(counts.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r)
-      for (std::size_t k = r * kRange; k < std::min(n, (r + 1) * kRange); ++k)
-        counts[r] += slot[k] >= 0 ? 1 : 0;
+    for (std::size_t r = begin; r < end; ++r) {
+      std::uint32_t marked = 0;
+      for (std::size_t k = r * kRange, last = std::min(n, k + kRange); k < last; ++k)
+        marked += slot[k] >= 0 ? 1 : 0;
+      counts[r] = marked;
+    }
   });
   std::uint32_t total = 0;
   for (std::uint32_t& c : counts) total += std::exchange(c, total);
   pool.for_each(counts.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t r = begin; r < end; ++r) {
       auto next = static_cast<std::int32_t>(counts[r]);
-      for (std::size_t k = r * kRange; k < std::min(n, (r + 1) * kRange); ++k)
+      for (std::size_t k = r * kRange, last = std::min(n, k + kRange); k < last; ++k)
         slot[k] = slot[k] >= 0 ? next++ : -1;
     }
   });
