@@ -65,9 +65,42 @@ def quat_from_axis_angle(axis, angle):
     return [math.cos(angle / 2), axis[0] * s, axis[1] * s, axis[2] * s]
 
 
-def pile(n_side=10, layers=10, seed=7):
+def rotation_columns(q):
+    """The body axes in the world (columns of the rotation) of unit quaternion q = (w, x, y, z)."""
+    w, x, y, z = q
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)],
+            [2 * (x * y - w * z), 1 - 2 * (x * x + z * z), 2 * (y * z + w * x)],
+            [2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)]]
+
+
+def box_separation(a, b):
+    """Signed distance of boxes a and b, each (centre, axes, half extents): the largest
+    separation over the 15 separating axes (< 0: minus their overlap depth), as the engine's
+    box_separation finds it."""
+    (ca, ra, ha), (cb, rb, hb) = a, b
+    dot = lambda u, v: sum(p * q for p, q in zip(u, v))
+    d = [q - p for p, q in zip(ca, cb)]
+    axes = ra + rb + [[u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                       u[0] * v[1] - u[1] * v[0]] for u in ra for v in rb]
+    best = -math.inf
+    for axis in axes:
+        n = math.sqrt(dot(axis, axis))
+        if n < 1e-6:
+            continue
+        u = [c / n for c in axis]
+        reach = (sum(h * abs(dot(e, u)) for e, h in zip(ra, ha)) +
+                 sum(h * abs(dot(e, u)) for e, h in zip(rb, hb)))
+        best = max(best, abs(dot(d, u)) - reach)
+    return best
+
+
+def pile(n_side=10, layers=10, seed=7, clearance=0.01):
+    """Boxes of random size and pose on a grid. A box that its random turn would leave closer
+    than `clearance` (m) to a box already placed (some did overlap by up to 10 cm) is turned
+    again with draws from a second generator, so every other box keeps its draws."""
     rng = random.Random(seed)
-    bodies = []
+    again = random.Random(seed + 1)
+    bodies, placed = [], []
     spacing = 0.8
     for layer in range(layers):
         for i in range(n_side):
@@ -78,10 +111,19 @@ def pile(n_side=10, layers=10, seed=7):
                        1.0 + layer * spacing,
                        (k - (n_side - 1) / 2) * spacing + rng.uniform(-0.05, 0.05)]
                 axis = [rng.uniform(-1, 1) for _ in range(3)]
-                q = quat_from_axis_angle(axis, rng.uniform(0, math.pi))
+                q = [round(v, 9) for v in quat_from_axis_angle(axis, rng.uniform(0, math.pi))]
+                half = [h / 2 for h in size]
+                centre = [round(v, 6) for v in pos]
+                near = [p for p in placed
+                        if math.dist(p[0], centre) < math.hypot(*half) + math.hypot(*p[2])]
+                while any(box_separation((centre, rotation_columns(q), half), p) < clearance
+                          for p in near):
+                    axis = [again.uniform(-1, 1) for _ in range(3)]
+                    q = [round(v, 9) for v in quat_from_axis_angle(axis, again.uniform(0, math.pi))]
+                placed.append((centre, rotation_columns(q), half))
                 bodies.append(box(f"b{len(bodies)}", size, mass, pos,
                                   COLORS[len(bodies) % len(COLORS)],
-                                  orientation=[round(v, 9) for v in q],
+                                  orientation=q,
                                   velocity=[round(rng.uniform(-0.5, 0.5), 3), 0,
                                             round(rng.uniform(-0.5, 0.5), 3)]))
     return scene("pile", f"{len(bodies)} boxes of random size and pose dropped from a "
