@@ -75,8 +75,8 @@ def rotation_columns(q):
 
 def box_separation(a, b):
     """Signed distance of boxes a and b, each (centre, axes, half extents): the largest
-    separation over the 15 separating axes (< 0: minus their overlap depth), as the engine's
-    box_separation finds it."""
+    separation over the 15 separating axes (< 0: minus their overlap depth), the test
+    `tumble-bench contact` measures penetration with (bench/contact/penetration.cpp)."""
     (ca, ra, ha), (cb, rb, hb) = a, b
     dot = lambda u, v: sum(p * q for p, q in zip(u, v))
     d = [q - p for p, q in zip(ca, cb)]
@@ -115,7 +115,8 @@ def pile(n_side=10, layers=10, seed=7, clearance=0.01):
                 half = [h / 2 for h in size]
                 centre = [round(v, 6) for v in pos]
                 near = [p for p in placed
-                        if math.dist(p[0], centre) < math.hypot(*half) + math.hypot(*p[2])]
+                        if math.dist(p[0], centre) <
+                        math.hypot(*half) + math.hypot(*p[2]) + clearance]
                 while any(box_separation((centre, rotation_columns(q), half), p) < clearance
                           for p in near):
                     axis = [again.uniform(-1, 1) for _ in range(3)]
