@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <span>
 #include <utility>
 
 #include "box_box.hpp"
@@ -56,16 +57,51 @@ void write_contact(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const
 }
 
 /// The manifold of pair p, or none (count 0) when its boxes will not touch within the step.
-BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared) {
+/// `recordable` is set when the boxes move less than kRecycleDistance a step (the manifold is
+/// worth keeping for the next: manifold_record.hpp).
+BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared,
+                        bool& recordable) {
   const Body& a = ctx.bodies[p.first];
   const Body& b = ctx.bodies[p.second];
   const Motion ma = motion(ctx, p.first, shared), mb = motion(ctx, p.second, shared);
   const double closing = ctx.dt * ((ma.v - mb.v).norm() + ma.w.norm() * a.c.bounding_radius +
                                    mb.w.norm() * b.c.bounding_radius);
+  recordable = closing < kRecycleDistance;
   BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, kSpeculativeDistance + closing);
   if (m.count > 0 && !touches(m, a, ma, b, mb, ctx.dt)) m.count = 0;
   return m;
 }
+
+/// Pair p's manifold from `record` into `out` while its boxes are still close to the record's
+/// pose (false: not recycled, `out` untouched), its count 0 when they will not touch within
+/// the step.
+bool recycled(const StepContext& ctx, const BodyPair& p, bool shared,
+              const ManifoldRecord& record, BoxManifold& out) {
+  const Body& a = ctx.bodies[p.first];
+  const Body& b = ctx.bodies[p.second];
+  if (!recycle_manifold(record, a.s, a.c.bounding_radius, b.s, b.c.bounding_radius, out))
+    return false;
+  const Motion ma = motion(ctx, p.first, shared), mb = motion(ctx, p.second, shared);
+  if (!touches(out, a, ma, b, mb, ctx.dt)) out.count = 0;
+  return true;
+}
+
+/// Finds pairs in a sorted list by walking it with ascending pairs.
+class PairWalk {
+ public:
+  /// Starts at the first entry of `list` not below `first`.
+  PairWalk(std::span<const BodyPair> list, const BodyPair& first)
+      : list_(list), at_(std::lower_bound(list.begin(), list.end(), first)) {}
+  /// Index of `p` in the list, or −1; p not below the pair of the call before.
+  std::int32_t find(const BodyPair& p) {
+    while (at_ != list_.end() && *at_ < p) ++at_;
+    return at_ != list_.end() && *at_ == p ? static_cast<std::int32_t>(at_ - list_.begin()) : -1;
+  }
+
+ private:
+  std::span<const BodyPair> list_;
+  std::span<const BodyPair>::iterator at_;
+};
 
 /// Numbers the marked items in order: slot[k] ≥ 0 (marked) becomes the item's position among
 /// them, −1 stays; returns how many. The marks are set on the pool where each item is found:
@@ -100,6 +136,30 @@ std::uint32_t number_slots(std::vector<std::int32_t>& slot, std::vector<std::uin
     }
   });
   return total;
+}
+
+/// The next step's records (ContactCache::records), in pair order: each pair with a manifold
+/// keeps the record it came from, or records its new one when its boxes move slowly
+/// (record_slot marks both, record_from says which).
+void keep_records(StepContext& ctx) {
+  StepScratch& s = ctx.scratch;
+  const std::uint32_t count = number_slots(s.record_slot, s.slot_counts, ctx.pool);
+  s.next_record_pairs.resize(count);
+  s.next_records.resize(count);
+  ctx.pool.for_each(s.pairs.size(), 64, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      const std::int32_t r = s.record_slot[k];
+      if (r < 0) continue;
+      const BodyPair& p = s.pairs[k];
+      s.next_record_pairs[r] = p;
+      s.next_records[r] = s.record_from[k] >= 0
+                              ? ctx.cache.records[s.record_from[k]]
+                              : record_manifold(s.manifolds[k], ctx.bodies[p.first].s,
+                                                ctx.bodies[p.second].s);
+    }
+  });
+  std::swap(ctx.cache.record_pairs, s.next_record_pairs);
+  std::swap(ctx.cache.records, s.next_records);
 }
 
 /// The bodies of the box–box contacts, ascending, each once. With many contacts, by marking
@@ -154,23 +214,38 @@ void collide_pairs(StepContext& ctx) {
   // Only the manifolds with points are kept (a quarter of `pile`'s pairs).
   s.manifolds.resize(s.pairs.size());
   s.slot.resize(s.pairs.size());
+  s.record_from.resize(s.pairs.size());
+  s.record_slot.resize(s.pairs.size());
+  const std::span<const BodyPair> record_pairs(ctx.cache.record_pairs);
   ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    // Both lists are sorted: one search, then a walk.
-    auto e = std::lower_bound(earlier.begin(), earlier.end(), s.pairs[begin]);
+    // The lists are sorted: one search each, then walks.
+    PairWalk in_earlier(earlier, s.pairs[begin]), in_records(record_pairs, s.pairs[begin]);
     for (std::size_t k = begin; k < end; ++k) {
-      while (e != earlier.end() && *e < s.pairs[k]) ++e;
-      if (e != earlier.end() && *e == s.pairs[k]) {
-        const auto at = static_cast<std::size_t>(e - earlier.begin());
+      const std::int32_t record = in_records.find(s.pairs[k]);
+      const std::int32_t at = in_earlier.find(s.pairs[k]);
+      if (at >= 0) {  // the earlier round's manifold, and the record it kept, if any
         s.slot[k] = s.earlier_slot[at] >= 0 ? 0 : -1;
         if (s.slot[k] == 0) s.manifolds[k] = s.earlier_manifolds[at];
+        s.record_from[k] = record;
+        s.record_slot[k] = s.slot[k] == 0 && record >= 0 ? 0 : -1;
         continue;
       }
-      const BoxManifold m = manifold_of(ctx, s.pairs[k], shared);
+      if (record >= 0 &&
+          recycled(ctx, s.pairs[k], shared, ctx.cache.records[record], s.manifolds[k])) {
+        s.slot[k] = s.record_slot[k] = s.manifolds[k].count > 0 ? 0 : -1;
+        s.record_from[k] = record;
+        continue;
+      }
+      bool recordable = false;
+      const BoxManifold m = manifold_of(ctx, s.pairs[k], shared, recordable);
       s.slot[k] = m.count > 0 ? 0 : -1;
       if (m.count > 0) s.manifolds[k] = m;
+      s.record_from[k] = -1;
+      s.record_slot[k] = m.count > 0 && recordable ? 0 : -1;
     }
   });
   const std::uint32_t count = number_slots(s.slot, s.slot_counts, ctx.pool);
+  keep_records(ctx);
   s.links.resize(count);
   s.wakes.resize(count);
   ctx.stats.contact_points = 0;

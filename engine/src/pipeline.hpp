@@ -29,6 +29,7 @@
 #include "contact_solver.hpp"
 #include "integrators.hpp"
 #include "islands.hpp"
+#include "manifold_record.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
 #include "tumble/step_stats.hpp"
@@ -53,6 +54,10 @@ struct ContactCache {
   std::vector<Contact> previous;
   /// (pair key, index into previous), sorted by key.
   std::vector<std::pair<std::uint64_t, std::uint32_t>> previous_keys;
+  /// Box–box manifolds in their bodies' frames, reused while a pair barely moves
+  /// (manifold_record.hpp): each record's pair, sorted, and the records in that order.
+  std::vector<BodyPair> record_pairs;
+  std::vector<ManifoldRecord> records;
   /// Counts changes of any body's activity (wake, sleep, freeze): caches derived from the
   /// activity flags are valid while it stays put.
   std::uint64_t activity_epoch = 0;
@@ -107,6 +112,12 @@ struct StepScratch {
   std::vector<Contact> floor_slots;     ///< Floor contact of each linked body (count 0: none).
   std::vector<std::int32_t> slot;       ///< Position of each pair's box–box contact, or −1.
   std::vector<std::int32_t> floor_slot; ///< Position of each linked body's floor contact, or −1.
+  /// Per pair: the index of the record its manifold came from (ContactCache::records), or −1
+  /// for a new manifold.
+  std::vector<std::int32_t> record_from;
+  std::vector<std::int32_t> record_slot;  ///< Position of each pair's next record, or −1.
+  std::vector<BodyPair> next_record_pairs;    ///< The records being built (swapped into the cache).
+  std::vector<ManifoldRecord> next_records;
   std::vector<std::uint32_t> slot_counts;  ///< Marked slots per range (number_slots).
   std::vector<std::uint32_t> linked;    ///< Bodies in box–box contacts, ascending.
   std::vector<std::uint8_t> marked;     ///< Scratch of `linked`: body is in a box–box contact.
