@@ -217,6 +217,7 @@ void collide_pairs(StepContext& ctx) {
   s.record_from.resize(s.pairs.size());
   s.record_slot.resize(s.pairs.size());
   const std::span<const BodyPair> record_pairs(ctx.cache.record_pairs);
+  std::atomic<bool> any_record = false;
   ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     // The lists are sorted: one search each, then walks.
     PairWalk in_earlier(earlier, s.pairs[begin]), in_records(record_pairs, s.pairs[begin]);
@@ -243,9 +244,17 @@ void collide_pairs(StepContext& ctx) {
       s.record_from[k] = -1;
       s.record_slot[k] = m.count > 0 && recordable ? 0 : -1;
     }
+    if (std::any_of(s.record_slot.begin() + begin, s.record_slot.begin() + end,
+                    [](std::int32_t r) { return r >= 0; }))
+      any_record.store(true, std::memory_order_relaxed);
   });
   const std::uint32_t count = number_slots(s.slot, s.slot_counts, ctx.pool);
-  keep_records(ctx);
+  if (any_record.load(std::memory_order_relaxed)) {
+    keep_records(ctx);
+  } else {  // a falling pile records nothing: no pass over its pairs to say so
+    ctx.cache.record_pairs.clear();
+    ctx.cache.records.clear();
+  }
   s.links.resize(count);
   s.wakes.resize(count);
   ctx.stats.contact_points = 0;
