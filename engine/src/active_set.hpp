@@ -123,14 +123,27 @@ inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   return inv_norm.asDiagonal() * Pn * inv_norm.asDiagonal();
 }
 
-/// G = Σ dᵢ dᵢᵀ over the rows listed in idx[0..m).
-inline Mat3 gram(const PlaneCoordinates& D, const int* idx, int m) {
-  Mat3 G = Mat3::Zero();
-  for (int a = 0; a < m; ++a) {
-    const Vec3 d = D.row(idx[a]).transpose();
-    G.noalias() += d * d.transpose();
-  }
+/// The Gram matrix of rows (1, αᵢ, βᵢ) from its five sums Σα, Σβ, Σα², Σαβ, Σβ² (and the count
+/// m = Σ 1·1), mirrored: αβ = βα, so the lower triangle is the upper one to the bit.
+inline Mat3 gram_of_sums(int m, double a, double b, double aa, double ab, double bb) {
+  Mat3 G;
+  G << m, a, b, a, aa, ab, b, ab, bb;
   return G;
+}
+
+/// G = Σ dᵢ dᵢᵀ over the rows listed in idx[0..m), summed in that order (the sums of
+/// gram_of_sums; dᵢ's leading 1 makes its products exact, so they are left out).
+inline Mat3 gram(const PlaneCoordinates& D, const int* idx, int m) {
+  double a = 0.0, b = 0.0, aa = 0.0, ab = 0.0, bb = 0.0;
+  for (int k = 0; k < m; ++k) {
+    const double alpha = D(idx[k], 1), beta = D(idx[k], 2);
+    a += alpha;
+    b += beta;
+    aa += alpha * alpha;
+    ab += alpha * beta;
+    bb += beta * beta;
+  }
+  return gram_of_sums(m, a, b, aa, ab, bb);
 }
 
 /// P with K⁺ = D P Dᵀ over all rows of D.

@@ -30,7 +30,7 @@ void prepare_friction(const Contact& c, ContactRows& rows, const SolverBody* a,
 /// The normal block of `rows` (ContactRows): the columns C, D, G, P G and P Dᵀ target, with
 /// K = D S Dᵀ formed from the columns (active_set.hpp: S = Σ Cᵀ I⁻¹ C + m⁻¹ e₀e₀ᵀ).
 void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
-                   const SolverBody* b, const Vec3& ra0, const Vec3& rb0, double dt) {
+                   const SolverBody* b, const Vec3& ra0, const Vec3& rb0) {
   const Vec3& n = rows.dir[0];
   rows.ca = {a ? Vec3(ra0.cross(n)) : Vec3::Zero(), rows.dir[1].cross(n), rows.dir[2].cross(n)};
   rows.cb = {rb0.cross(n), rows.ca[1], rows.ca[2]};
@@ -39,15 +39,24 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
     rows.inv_cb[k] = b->inv_inertia * rows.cb[k];
   }
   rows.D.resize(c.count, 3);
-  rows.G.setZero();
+  // G = Σ dᵢ dᵢᵀ and Dᵀ target = Σ targetᵢ dᵢ, dᵢ = (1, αᵢ, βᵢ): by its sums (gram_of_sums).
+  double sa = 0.0, sb = 0.0, saa = 0.0, sab = 0.0, sbb = 0.0;
   Vec3 dt_target = Vec3::Zero();
   for (int i = 0; i < c.count; ++i) {
     const Vec3 o = c.points[i].rb - rb0;
-    const Vec3 d(1.0, o.dot(rows.dir[1]), o.dot(rows.dir[2]));
-    rows.D.row(i) = d.transpose();
-    rows.G.noalias() += d * d.transpose();
-    dt_target += Solver::target_of(c.points[i], dt) * d;
+    const double alpha = o.dot(rows.dir[1]), beta = o.dot(rows.dir[2]);
+    rows.D.row(i) << 1.0, alpha, beta;
+    sa += alpha;
+    sb += beta;
+    saa += alpha * alpha;
+    sab += alpha * beta;
+    sbb += beta * beta;
+    const double target = rows.points[i].target;  // Solver::target_of, set by prepare
+    dt_target(0) += target;
+    dt_target(1) += target * alpha;
+    dt_target(2) += target * beta;
   }
+  rows.G = gram_of_sums(c.count, sa, sb, saa, sab, sbb);
   Mat3 P = Mat3::Zero();
   if (c.count == 1) {
     P(0, 0) = rows.points[0].normal_mass;
@@ -100,7 +109,7 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt) {
   }
   ra0 /= c.count;
   rb0 /= c.count;
-  prepare_block(c, block, a, b, ra0, rb0, dt);
+  prepare_block(c, block, a, b, ra0, rb0);
   // Friction acts at the patch's centre of pressure (see solve_friction).
   double load = 0.0;
   Vec3 ra_load = Vec3::Zero(), rb_load = Vec3::Zero();
