@@ -18,7 +18,8 @@ inline constexpr int kMaxActiveSetPoints = 8;
 /// Per-point values (velocities, targets, impulses).
 using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActiveSetPoints, 1>;
 
-/// Rows (1, α, β) of contact points: α, β their coordinates in the contact plane, m.
+/// Rows (1, α, β) of contact points: α, β their coordinates in the contact plane, m. The leading
+/// 1 is exactly 1.0 (gram, row_dot and add_row leave its products out).
 using PlaneCoordinates =
     Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, kMaxActiveSetPoints, 3>;
 
@@ -146,6 +147,18 @@ inline Mat3 gram(const PlaneCoordinates& D, const int* idx, int m) {
   return gram_of_sums(m, a, b, aa, ab, bb);
 }
 
+/// (1, α, β) · v over row i of D, as the dot product sums it: the leading 1's product is v₀.
+inline double row_dot(const PlaneCoordinates& D, int i, const Vec3& v) {
+  return (v(0) + D(i, 1) * v(1)) + D(i, 2) * v(2);
+}
+
+/// acc += s (1, α, β) over row i of D (the leading 1's product is s).
+inline void add_row(Vec3& acc, double s, const PlaneCoordinates& D, int i) {
+  acc(0) += s;
+  acc(1) += s * D(i, 1);
+  acc(2) += s * D(i, 2);
+}
+
 /// P with K⁺ = D P Dᵀ over all rows of D.
 inline Mat3 pseudo_inverse_factor(const PlaneCoordinates& D, const Mat3& S) {
   std::array<int, kMaxActiveSetPoints> all{};
@@ -202,7 +215,11 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
   const int n = static_cast<int>(vn.size());
   const PlaneCoordinates& D = cache.system().D;
   std::array<bool, kMaxActiveSetPoints> active{};
-  for (int i = 0; i < n; ++i) active[i] = vn(i) < target(i) - 1e-15;
+  std::array<double, kMaxActiveSetPoints> gap;  // target − vn
+  for (int i = 0; i < n; ++i) {
+    active[i] = vn(i) < target(i) - 1e-15;
+    gap[i] = target(i) - vn(i);
+  }
   PointVector impulse = PointVector::Zero(n);
   std::array<unsigned, kIterations> seen;  // the active set (mask) of each iteration so far
   bool periodic = false;
@@ -225,9 +242,9 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
     impulse.setZero();
     if (m > 0) {
       Vec3 y = Vec3::Zero();  // D_aᵀ (target − vn) over the active points
-      for (int a = 0; a < m; ++a) y += (target(idx[a]) - vn(idx[a])) * D.row(idx[a]).transpose();
+      for (int a = 0; a < m; ++a) add_row(y, gap[idx[a]], D, idx[a]);
       const Vec3 z = cache.factor(mask, idx, m) * y;
-      for (int a = 0; a < m; ++a) impulse(idx[a]) = D.row(idx[a]).dot(z);
+      for (int a = 0; a < m; ++a) impulse(idx[a]) = row_dot(D, idx[a], z);
     }
     // Drop the most negative impulse, else add the most violated passive point.
     int worst = -1;
@@ -239,12 +256,13 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
       continue;
     }
     Vec3 load = Vec3::Zero();  // Dᵀ j
-    for (int i = 0; i < n; ++i) load += impulse(i) * D.row(i).transpose();
+    for (int i = 0; i < n; ++i) add_row(load, impulse(i), D, i);
     const Vec3 response = cache.system().S * load;  // K j = D S Dᵀ j
     worst_value = -1e-12;
     for (int i = 0; i < n; ++i) {
-      const double after = vn(i) + D.row(i).dot(response);
-      if (!active[i] && after - target(i) < worst_value) worst = i, worst_value = after - target(i);
+      if (active[i]) continue;
+      const double after = vn(i) + row_dot(D, i, response);
+      if (after - target(i) < worst_value) worst = i, worst_value = after - target(i);
     }
     if (worst < 0) break;
     active[worst] = true;
