@@ -73,6 +73,27 @@ Mat3 reduced_pseudo_inverse(const Mat3& V, const Mat3& W, const Mat3& S) {
   return Wr * T.inverse() * Wr.transpose();
 }
 
+// G⁻¹ in the operations of Eigen's 3×3 inverse (the cofactors, det G from the first column's,
+// its reciprocal), whose det G also serves the rank test, which used to compute it a second
+// time by G.determinant() (by the first row). For a G symmetric to the bit (gram_of_sums) the
+// two are the same bits: their three terms are the same products, the middle one negated
+// (a − b = −(b − a) exactly), except where that cofactor's two products are equal; then they
+// can differ only in the sign of a zero, which fails the test (bound ≥ 0) either way.
+/// True, with Gi = G⁻¹, when det G > bound (≥ 0); G symmetric (gram_of_sums).
+inline bool inverse_above(const Mat3& G, double bound, Mat3& Gi) {
+  const Vec3 c0(G(1, 1) * G(2, 2) - G(1, 2) * G(2, 1), G(2, 1) * G(0, 2) - G(2, 2) * G(0, 1),
+                G(0, 1) * G(1, 2) - G(0, 2) * G(1, 1));  // column 0 of the cofactor matrix
+  const double det = c0.cwiseProduct(G.col(0)).sum();
+  if (!(det > bound)) return false;
+  const double inv = 1.0 / det;
+  Gi << c0(0) * inv, c0(1) * inv, c0(2) * inv,
+      (G(1, 2) * G(2, 0) - G(1, 0) * G(2, 2)) * inv, (G(2, 2) * G(0, 0) - G(2, 0) * G(0, 2)) * inv,
+      (G(0, 2) * G(1, 0) - G(0, 0) * G(1, 2)) * inv,
+      (G(1, 0) * G(2, 1) - G(1, 1) * G(2, 0)) * inv, (G(2, 0) * G(0, 1) - G(2, 1) * G(0, 0)) * inv,
+      (G(0, 0) * G(1, 1) - G(0, 1) * G(1, 0)) * inv;
+  return true;
+}
+
 /// P with K⁺ = D P Dᵀ for K = D S Dᵀ (S symmetric positive definite): closed form when the
 /// points span the plane, else through the eigendecomposition of D's Gram matrix G = DᵀD with
 /// its columns scaled to unit length, dropping directions below 1e-6 of the largest.
@@ -86,11 +107,8 @@ Mat3 reduced_pseudo_inverse(const Mat3& V, const Mat3& W, const Mat3& S) {
 // impulses of 1,500 N·s to a 1 kg box.
 inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   constexpr double kRank = 1e-6;
-  const double det = G.determinant();
-  if (det > kRank * G(0, 0) * G(1, 1) * G(2, 2)) {
-    const Mat3 Gi = G.inverse();
-    return Gi * S.inverse() * Gi;
-  }
+  Mat3 Gi;
+  if (inverse_above(G, kRank * G(0, 0) * G(1, 1) * G(2, 2), Gi)) return Gi * S.inverse() * Gi;
   // D = D̂ N⁻¹ with D̂'s columns of unit length (N = diag(1/√Gₖₖ); a zero column stays zero),
   // so K = D̂ Ŝ D̂ᵀ with Ŝ = N⁻¹ S N⁻¹, and P = N P̂ N.
   Vec3 norm, inv_norm;
