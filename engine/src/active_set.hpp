@@ -238,11 +238,11 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
     active[i] = vn(i) < target(i) - 1e-15;
     gap[i] = target(i) - vn(i);
   }
-  PointVector impulse = PointVector::Zero(n);
+  PointVector impulse(n);  // zeroed by each iteration
   std::array<unsigned, kIterations> seen;  // the active set (mask) of each iteration so far
   bool periodic = false;
   for (int iter = 0; iter < kIterations; ++iter) {
-    std::array<int, kMaxActiveSetPoints> idx{};
+    std::array<int, kMaxActiveSetPoints> idx;  // the active points, idx[0..m)
     int m = 0;
     unsigned mask = 0;
     for (int i = 0; i < n; ++i)
