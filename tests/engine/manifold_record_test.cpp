@@ -8,7 +8,7 @@
 namespace tumble {
 namespace {
 
-BodyState at(const Vec3& x, const Mat3& R) {
+BodyState pose(const Vec3& x, const Mat3& R) {
   BodyState s;
   s.x = x;
   s.R = R;
@@ -18,7 +18,7 @@ BodyState at(const Vec3& x, const Mat3& R) {
 /// A pose of b resting on a's top face, in a's frame moved to world by (Ra, xa), with b's
 /// offset (in a's frame) and turn about a's normal.
 BodyState on_top(const BodyState& a, const Vec3& offset, double turn) {
-  return at(a.x + a.R * offset, a.R * axis_rotation(1, turn));
+  return pose(a.x + a.R * offset, a.R * axis_rotation(1, turn));
 }
 
 /// Each point of `m` against the fresh manifold's point with the same feature id.
@@ -35,11 +35,11 @@ void expect_same_points(const BoxManifold& recycled, const BoxManifold& fresh, d
   }
 }
 
-class ManifoldRecordTest : public testing::Test {
+class ManifoldRecordTest : public ::testing::Test {
  protected:
   const BodyConstants c = make_body_constants(BodyDef{}, 0.0, 0.0);
   // a turned well away from the world axes, so the frames matter.
-  const BodyState a = at({0.3, 2.0, -1.0}, axis_rotation(0, 0.7) * axis_rotation(2, -0.4));
+  const BodyState a = pose({0.3, 2.0, -1.0}, axis_rotation(0, 0.7) * axis_rotation(2, -0.4));
   const BodyState b = on_top(a, {0.2, 0.99, 0.1}, 0.3);
   const BoxManifold recorded = collide_boxes(a, c, b, c, 0.02);
   const ManifoldRecord record = record_manifold(recorded, a, b);
@@ -55,7 +55,7 @@ TEST_F(ManifoldRecordTest, TheSameRelativePoseAnywhereGivesTheFreshManifold) {
   // Both boxes carried by one rigid motion: the relative pose is the recorded one.
   const Mat3 turn = axis_rotation(2, 2.1) * axis_rotation(1, -1.3);
   const Vec3 shift(5.0, -3.0, 7.0);
-  const BodyState a2 = at(turn * a.x + shift, turn * a.R), b2 = at(turn * b.x + shift, turn * b.R);
+  const BodyState a2 = pose(turn * a.x + shift, turn * a.R), b2 = pose(turn * b.x + shift, turn * b.R);
   BoxManifold m;
   ASSERT_TRUE(recycle(a2, b2, m));
   expect_same_points(m, collide_boxes(a2, c, b2, c, 0.02), 1e-14, 1e-14);
@@ -80,7 +80,7 @@ TEST_F(ManifoldRecordTest, AMoveBeyondTheDistanceIsNotRecycled) {
   // A turn about the normal moving b's corners by ~2 mm.
   EXPECT_FALSE(recycle(a, on_top(a, {0.2, 0.99, 0.1}, 0.3 + 2e-3 / c.bounding_radius), m));
   // b tipped 1.5 mrad about a horizontal axis.
-  EXPECT_FALSE(recycle(a, at(b.x, b.R * axis_rotation(0, 1.5e-3)), m));
+  EXPECT_FALSE(recycle(a, pose(b.x, b.R * axis_rotation(0, 1.5e-3)), m));
   EXPECT_EQ(m.count, -1);
 }
 
