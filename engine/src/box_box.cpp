@@ -206,6 +206,15 @@ bool edge_contact(const BodyState& a, const BodyConstants& ca, const BodyState& 
   return true;
 }
 
+/// The manifold when no axis separates boxes a and b by the margin but the reference face's
+/// clipping keeps no point: two corners, or a corner and an edge, nearest each other beside
+/// the reference face, where no separating axis points along the gap. One point along the
+/// line between the boxes' nearest points, whose separation along that line is their
+/// distance, when it is below the margin (else nothing). Without it a cube flying corner
+/// first at another's corner at 40 m/s got no contact until it was 23 cm inside.
+void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                            const BodyConstants& cb, double margin, BoxManifold& m);
+
 }  // namespace
 
 // Separating-axis test for oriented boxes (Gottschalk, Lin & Manocha, "OBBTree", SIGGRAPH
@@ -288,7 +297,65 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
     m.normal = n_ref;
   }
   m.count = reduce_to_four(clipped, n, m.normal, m.points);
+  if (m.count == 0) nearest_points_contact(a, ca, b, cb, margin, m);
   return m;
 }
+
+double separation_along(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                        const BodyConstants& cb, const Vec3& n) {
+  // Each box's half width along n: Σ_k h_k |R_k · n|.
+  const double ra = (a.R.transpose() * n).cwiseAbs().dot(ca.half_extents);
+  const double rb = (b.R.transpose() * n).cwiseAbs().dot(cb.half_extents);
+  return (b.x - a.x).dot(n) - ra - rb;
+}
+
+namespace {
+
+/// The point of box (s, c) nearest to p (p itself when inside).
+Vec3 nearest_on_box(const BodyState& s, const BodyConstants& c, const Vec3& p) {
+  const Vec3 local = s.R.transpose() * (p - s.x);
+  return s.x + s.R * local.cwiseMax(-c.half_extents).cwiseMin(c.half_extents);
+}
+
+}  // namespace
+
+std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                                  const BodyConstants& cb, int rounds) {
+  Vec3 pa = nearest_on_box(a, ca, b.x);
+  Vec3 pb = nearest_on_box(b, cb, pa);
+  for (int i = 0; i < rounds; ++i) {
+    const Vec3 qa = nearest_on_box(a, ca, pb);
+    const Vec3 qb = nearest_on_box(b, cb, qa);
+    const double moved = (qa - pa).squaredNorm() + (qb - pb).squaredNorm();
+    pa = qa;
+    pb = qb;
+    if (moved < 1e-18) break;
+  }
+  return {pa, pb};
+}
+
+namespace {
+
+// kNearestPointsId: box–box ids set bit 31 for an edge pair and bits 12–15 for a face.
+constexpr std::uint32_t kNearestPointsId = 1u << 30;
+constexpr int kNearestPointsRounds = 16;
+
+void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                            const BodyConstants& cb, double margin, BoxManifold& m) {
+  const auto [pa, pb] = near_points(a, ca, b, cb, kNearestPointsRounds);
+  const Vec3 line = pb - pa;
+  const double length = line.norm();
+  if (!(length > 0.0)) return;  // overlapping: the projections met inside both boxes
+  const Vec3 n = line / length;
+  const double separation = separation_along(a, ca, b, cb, n);
+  if (!(separation < margin)) return;
+  m.normal = n;
+  m.count = 1;
+  m.points[0].position = 0.5 * (pa + pb);
+  m.points[0].separation = separation;
+  m.points[0].id = kNearestPointsId;
+}
+
+}  // namespace
 
 }  // namespace tumble

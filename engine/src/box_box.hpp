@@ -4,6 +4,7 @@
 /// Pure functions; thread-safe.
 #include <array>
 #include <cstdint>
+#include <utility>
 
 #include "tumble/body.hpp"
 
@@ -31,5 +32,18 @@ struct BoxManifold {
 /// before it penetrates). count == 0 when the boxes are farther apart than the margin.
 BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                           const BodyConstants& cb, double margin);
+
+/// Separation of boxes a and b along the unit axis n (world), m: how far b's projection on n
+/// lies beyond a's (negative where they overlap). A lower bound on the boxes' distance for
+/// every n, equal to it along the line between their nearest points.
+double separation_along(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                        const BodyConstants& cb, const Vec3& n);
+
+/// Points of boxes a and b (world, m) near each other: alternating projections from b's centre,
+/// each the nearest point of one box to the other's last (Cheney & Goldstein 1959: they approach
+/// the nearest pair of two disjoint convex sets), `rounds` rounds or until they move less than
+/// 1e-9 m.
+std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                                  const BodyConstants& cb, int rounds);
 
 }  // namespace tumble

@@ -78,6 +78,24 @@ TEST(BoxBox, SeparatedBeyondMarginGivesNothingWithinMarginGivesSpeculativePoints
   EXPECT_LT((m.normal - Vec3::UnitX()).norm(), 1e-15);
 }
 
+// Two cubes turned so that a corner of each points at the other along x, 0.2 m apart: the best
+// separating axis is a face normal 55° off x, along which the gap is only 0.12 m and the
+// faces' clipping keeps nothing (the other cube lies beside the face). The manifold is then
+// one point on the line between the nearest corners, at their distance.
+TEST(BoxBox, CornersBesideTheFacesMeetAlongTheirGap) {
+  const BodyConstants c = make_body_constants(BodyDef{}, 0.0, 0.0);
+  const Mat3 R = Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1), Vec3(1, 0, 0)).toRotationMatrix();
+  const double gap = 0.2, d = std::sqrt(3.0) + gap;
+  const BoxManifold m = collide_boxes(at({0, 0, 0}, R), c, at({d, 0, 0}, R), c, 0.3);
+  ASSERT_EQ(m.count, 1);
+  EXPECT_LT((m.normal - Vec3::UnitX()).norm(), 1e-12);
+  EXPECT_NEAR(m.points[0].separation, gap, 1e-12);
+  EXPECT_LT((m.points[0].position - Vec3(0.5 * d, 0, 0)).norm(), 1e-12);
+  EXPECT_NEAR(separation_along(at({0, 0, 0}, R), c, at({d, 0, 0}, R), c, Vec3::UnitX()), gap, 1e-12);
+  // Beyond the margin: nothing.
+  EXPECT_EQ(collide_boxes(at({0, 0, 0}, R), c, at({d + 0.2, 0, 0}, R), c, 0.3).count, 0);
+}
+
 TEST(BoxBox, CrossedEdgesMeetAtOnePoint) {
   // Two cubes turned 45° about x and about z, stacked so their edges cross at the origin.
   const BodyConstants c = make_body_constants(BodyDef{}, 0.0, 0.0);
@@ -142,9 +160,8 @@ TEST(Impact, HeadOnInelasticMovesOnTogether) {
 // one step starts with their bounding spheres 25 cm apart, beyond the 2 cm speculative
 // distance, and the corner would end that step 3 cm inside the face. The narrow phase keeps
 // a pair while its spheres are apart by less than what it closes in the step, so the
-// speculative contact stops the corner at the face. (Corner against corner at such speeds
-// still sinks: one normal cannot hold two corners that slide off each other; docs/engine.md,
-// "What is left".) The deepest overlap is measured after every step with the exact test.
+// speculative contact stops the corner at the face. The deepest overlap is measured after
+// every step with the exact test.
 TEST(Impact, FastCornerStopsAtTheFaceItFliesAt) {
   const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1), Vec3(1, 0, 0));
   char orientation[128];
@@ -167,6 +184,37 @@ TEST(Impact, FastCornerStopsAtTheFaceItFliesAt) {
   EXPECT_LT(world.body(0).s.x.x(), world.body(1).s.x.x()) << "passed through each other";
   EXPECT_GT(deepest, -1e-3) << "the corner went 1 mm or more into the face";
   std::cout << "[ measured ] corner at a face at 40 m/s: deepest overlap " << 0.0 - deepest << " m\n";
+}
+
+// Two cubes flying corner against corner at 40 m/s relative: no face or edge-pair axis points
+// along the gap between the corners, and the faces' clipping keeps no point (each cube lies
+// beside the other's faces), so the speculative contact is taken along the line between the
+// nearest corners (box_box.cpp, nearest_points_contact). Without it the pair had no contact
+// until the corners were 23 cm inside each other.
+TEST(Impact, FastCornersAgainstCornersDoNotSinkIntoEachOther) {
+  const Eigen::Quaterniond q = Eigen::Quaterniond::FromTwoVectors(Vec3(1, 1, 1), Vec3(1, 0, 0));
+  char orientation[128];
+  std::snprintf(orientation, sizeof orientation, "[%.17g, %.17g, %.17g, %.17g]", q.w(), q.x(),
+                q.y(), q.z());
+  const std::string o = orientation;
+  World world = world_from_json(
+      R"({"floor": null, "gravity": [0,0,0], "dt": 0.0166666666666667, "bodies": [
+        {"name": "a", "position": [-1.6666666666666667, 0, 0], "velocity": [20, 0, 0],
+         "orientation": )" + o + R"(},
+        {"name": "b", "position": [1.6666666666666667, 0, 0], "velocity": [-20, 0, 0],
+         "orientation": )" + o + R"(}]})");
+  double deepest = 0.0;
+  for (int i = 0; i < 60; ++i) {
+    world.step();
+    const Body& a = world.body(0);
+    const Body& b = world.body(1);
+    const BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, 0.0);
+    for (int k = 0; k < m.count; ++k) deepest = std::min(deepest, m.points[k].separation);
+  }
+  EXPECT_LT(world.body(0).s.P.x() * world.body(0).c.inv_mass, 19.0) << "the cubes never met";
+  EXPECT_GT(deepest, -0.01) << "the corners went 1 cm or more into each other";
+  std::cout << "[ measured ] corners against corners at 40 m/s: deepest overlap "
+            << 0.0 - deepest << " m\n";
 }
 
 // ---- stacks --------------------------------------------------------------------------------
