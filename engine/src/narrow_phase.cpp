@@ -69,7 +69,8 @@ BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared,
   recordable = closing < kRecycleDistance;
   // Bounding spheres farther apart than the margin: the boxes are too, and stay more than the
   // speculative distance apart over the step, so nothing the full test could keep touches.
-  // In `pile`'s fall 17–25 % of the pairs end here, each for a separating-axis test.
+  // In `pile`'s first 45 steps (its fall) 58 % of the pairs end here, each for a separating-
+  // axis test.
   const double margin = kSpeculativeDistance + closing;
   const double reach = a.c.bounding_radius + b.c.bounding_radius + margin;
   if ((b.s.x - a.s.x).squaredNorm() > reach * reach) return {};
