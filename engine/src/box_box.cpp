@@ -210,8 +210,8 @@ bool edge_contact(const BodyState& a, const BodyConstants& ca, const BodyState& 
 /// clipping keeps no point: two corners, or a corner and an edge, nearest each other beside
 /// the reference face, where no separating axis points along the gap. One point along the
 /// line between the boxes' nearest points, whose separation along that line is their
-/// distance, when it is below the margin (else nothing). Without it a cube flying corner
-/// first at another's corner at 40 m/s got no contact until it was 23 cm inside.
+/// distance, when they are apart by less than the margin (else nothing). Without it a cube
+/// flying corner first at another's corner at 40 m/s got no contact until it was 23 cm inside.
 void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                             const BodyConstants& cb, double margin, BoxManifold& m);
 
@@ -348,7 +348,9 @@ void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const B
   if (!(length > 0.0)) return;  // overlapping: the projections met inside both boxes
   const Vec3 n = line / length;
   const double separation = separation_along(a, ca, b, cb, n);
-  if (!(separation < margin)) return;
+  // Only apart, a gap the line measures: boxes that overlap (their projections stopped short
+  // of meeting inside both) leave `line` round-off small and its direction meaningless.
+  if (!(separation > 0.0 && separation < margin)) return;
   m.normal = n;
   m.count = 1;
   m.points[0].position = 0.5 * (pa + pb);
