@@ -206,6 +206,16 @@ bool edge_contact(const BodyState& a, const BodyConstants& ca, const BodyState& 
   return true;
 }
 
+/// The point of box (s, c) nearest to p (p itself when inside).
+Vec3 nearest_on_box(const BodyState& s, const BodyConstants& c, const Vec3& p) {
+  const Vec3 local = s.R.transpose() * (p - s.x);
+  return s.x + s.R * local.cwiseMax(-c.half_extents).cwiseMin(c.half_extents);
+}
+
+// kNearestPointsId: box–box ids set bit 31 for an edge pair and bits 12–15 for a face.
+constexpr std::uint32_t kNearestPointsId = 1u << 30;
+constexpr int kNearestPointsRounds = 16;
+
 /// The manifold when no axis separates boxes a and b by the margin but the reference face's
 /// clipping keeps no point: two corners, or a corner and an edge, nearest each other beside
 /// the reference face, where no separating axis points along the gap. One point along the
@@ -213,7 +223,22 @@ bool edge_contact(const BodyState& a, const BodyConstants& ca, const BodyState& 
 /// distance, when they are apart by less than the margin (else nothing). Without it a cube
 /// flying corner first at another's corner at 40 m/s got no contact until it was 23 cm inside.
 void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                            const BodyConstants& cb, double margin, BoxManifold& m);
+                            const BodyConstants& cb, double margin, BoxManifold& m) {
+  const auto [pa, pb] = near_points(a, ca, b, cb, kNearestPointsRounds);
+  const Vec3 line = pb - pa;
+  const double length = line.norm();
+  if (!(length > 0.0)) return;  // overlapping: the projections met inside both boxes
+  const Vec3 n = line / length;
+  const double separation = separation_along(a, ca, b, cb, n);
+  // Only apart, a gap the line measures: boxes that overlap (their projections stopped short
+  // of meeting inside both) leave `line` round-off small and its direction meaningless.
+  if (!(separation > 0.0 && separation < margin)) return;
+  m.normal = n;
+  m.count = 1;
+  m.points[0].position = 0.5 * (pa + pb);
+  m.points[0].separation = separation;
+  m.points[0].id = kNearestPointsId;
+}
 
 }  // namespace
 
@@ -309,16 +334,6 @@ double separation_along(const BodyState& a, const BodyConstants& ca, const BodyS
   return (b.x - a.x).dot(n) - ra - rb;
 }
 
-namespace {
-
-/// The point of box (s, c) nearest to p (p itself when inside).
-Vec3 nearest_on_box(const BodyState& s, const BodyConstants& c, const Vec3& p) {
-  const Vec3 local = s.R.transpose() * (p - s.x);
-  return s.x + s.R * local.cwiseMax(-c.half_extents).cwiseMin(c.half_extents);
-}
-
-}  // namespace
-
 std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                                   const BodyConstants& cb, int rounds) {
   Vec3 pa = nearest_on_box(a, ca, b.x);
@@ -333,31 +348,5 @@ std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, c
   }
   return {pa, pb};
 }
-
-namespace {
-
-// kNearestPointsId: box–box ids set bit 31 for an edge pair and bits 12–15 for a face.
-constexpr std::uint32_t kNearestPointsId = 1u << 30;
-constexpr int kNearestPointsRounds = 16;
-
-void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                            const BodyConstants& cb, double margin, BoxManifold& m) {
-  const auto [pa, pb] = near_points(a, ca, b, cb, kNearestPointsRounds);
-  const Vec3 line = pb - pa;
-  const double length = line.norm();
-  if (!(length > 0.0)) return;  // overlapping: the projections met inside both boxes
-  const Vec3 n = line / length;
-  const double separation = separation_along(a, ca, b, cb, n);
-  // Only apart, a gap the line measures: boxes that overlap (their projections stopped short
-  // of meeting inside both) leave `line` round-off small and its direction meaningless.
-  if (!(separation > 0.0 && separation < margin)) return;
-  m.normal = n;
-  m.count = 1;
-  m.points[0].position = 0.5 * (pa + pb);
-  m.points[0].separation = separation;
-  m.points[0].id = kNearestPointsId;
-}
-
-}  // namespace
 
 }  // namespace tumble
