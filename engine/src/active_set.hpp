@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
 #include "tumble/math.hpp"
@@ -64,13 +63,14 @@ inline NormalSystem make_normal_system(const Vec3& n, const Vec3& t1, const Vec3
   return sys;
 }
 
-/// W_r (V_rᵀ S V_r)⁻¹ W_rᵀ over the first R columns of V and W (R = 1, 2, 3).
+/// V H⁻¹ (Vᵀ S V)⁻¹ H⁻¹ Vᵀ with H = Vᵀ G V, for V's R orthonormal columns (R = 1, 2) spanning
+/// the range kept of G: P of pseudo_inverse_factor_of_gram on that range, whatever the basis.
 template <int R>
-Mat3 reduced_pseudo_inverse(const Mat3& V, const Mat3& W, const Mat3& S) {
-  const Eigen::Matrix<double, 3, R> Vr = V.template leftCols<R>();
-  const Eigen::Matrix<double, 3, R> Wr = W.template leftCols<R>();
-  const Eigen::Matrix<double, R, R> T = Vr.transpose() * S * Vr;
-  return Wr * T.inverse() * Wr.transpose();
+Mat3 reduced_pseudo_inverse(const Eigen::Matrix<double, 3, R>& V, const Mat3& G, const Mat3& S) {
+  const Eigen::Matrix<double, R, R> H = V.transpose() * G * V;
+  const Eigen::Matrix<double, R, R> T = V.transpose() * S * V;
+  const Eigen::Matrix<double, 3, R> W = V * H.inverse();
+  return W * T.inverse() * W.transpose();
 }
 
 // G⁻¹ in the operations of Eigen's 3×3 inverse (the cofactors, det G from the first column's,
@@ -95,16 +95,23 @@ inline bool inverse_above(const Mat3& G, double bound, Mat3& Gi) {
 }
 
 /// P with K⁺ = D P Dᵀ for K = D S Dᵀ (S symmetric positive definite): closed form when the
-/// points span the plane, else through the eigendecomposition of D's Gram matrix G = DᵀD with
-/// its columns scaled to unit length, dropping directions below 1e-6 of the largest.
+/// points span the plane; else on the range of D's Gram matrix G = DᵀD with its columns scaled
+/// to unit length, a plane (points on one line) or a line (one point).
 //
 // Both tests are scale-free: det G / (G₀₀ G₁₁ G₂₂) is the Gram determinant of D's normalised
-// columns (1 for orthogonal columns, 0 for collinear points), and the eigenvalues are those of
+// columns (1 for orthogonal columns, 0 for collinear points), and the rank test below reads
 // the same normalised matrix, so neither depends on the unit of length or the size of the
 // box. The bound 1e-6 treats points within about 1e-3 of the patch's size of one line as on
 // it. A looser bound (1e-10, which this replaced) let three points 40 µm off one edge of a
 // 1 m face pass as spanning the plane; the inverse of that nearly singular G then gave
 // impulses of 1,500 N·s to a 1 kg box.
+//
+// Below full rank, P = G⁺ X G⁺ with X = V (Vᵀ S V)⁻¹ Vᵀ for any orthonormal basis V of G's
+// range (write G = V H Vᵀ: then D P Dᵀ = K⁺). That basis needs no eigendecomposition: for G of
+// rank two, the cross product of two of its columns is normal to its range (each column lies
+// in it); for rank one, any non-zero column spans it. Eigen's iterative 3×3 eigensolver, which
+// this replaced, cost ~1,300 instructions a call and 6 % of all of `pile`'s (points on one
+// edge are common there); this costs a few hundred.
 inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   constexpr double kRank = 1e-6;
   Mat3 Gi;
@@ -118,26 +125,29 @@ inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   }
   const Mat3 Gn = inv_norm.asDiagonal() * G * inv_norm.asDiagonal();
   const Mat3 Sn = norm.asDiagonal() * S * norm.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<Mat3> eig(Gn);
-  const Vec3 lambda = eig.eigenvalues();
-  const double cutoff = kRank * lambda.cwiseAbs().maxCoeff();
-  // Keep the directions D̂ spans: W = V_r Λ_r⁻¹, then P̂ = W (V_rᵀ Ŝ V_r)⁻¹ Wᵀ, with r × r
-  // matrices of a fixed size (closed-form inverses; the dynamic-size inverse went through a
-  // general LU, a fifth of this function on a landing's edge contacts).
-  Mat3 V = Mat3::Zero(), W = Mat3::Zero();
-  int r = 0;
-  for (int k = 0; k < 3; ++k) {
-    if (lambda(k) <= cutoff) continue;
-    V.col(r) = eig.eigenvectors().col(k);
-    W.col(r) = eig.eigenvectors().col(k) / lambda(k);
-    ++r;
-  }
+  // Rank two when the largest column cross product, whose length lies between λ₁λ₂/√3 and
+  // λ₁λ₂ (λ₁ ≥ λ₂ ≥ 0 the eigenvalues kept; the trace is λ₁ to 2λ₁), exceeds 1e-6 of the
+  // trace squared: λ₂ above 1e-6 to 7e-6 of λ₁.
+  const Vec3 cross[3] = {Gn.col(1).cross(Gn.col(2)), Gn.col(2).cross(Gn.col(0)),
+                         Gn.col(0).cross(Gn.col(1))};
+  int k = 0;
+  for (int j = 1; j < 3; ++j)
+    if (cross[j].squaredNorm() > cross[k].squaredNorm()) k = j;
+  const double trace = Gn.trace();
   Mat3 Pn;
-  switch (r) {
-    case 0: return Mat3::Zero();
-    case 1: Pn = reduced_pseudo_inverse<1>(V, W, Sn); break;
-    case 2: Pn = reduced_pseudo_inverse<2>(V, W, Sn); break;
-    default: Pn = reduced_pseudo_inverse<3>(V, W, Sn); break;
+  if (cross[k].norm() > kRank * trace * trace) {
+    const Vec3 u = cross[k].normalized();  // normal to the range
+    const Vec3 ref = std::abs(u.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    Eigen::Matrix<double, 3, 2> V;
+    V.col(0) = u.cross(ref).normalized();
+    V.col(1) = u.cross(V.col(0));
+    Pn = reduced_pseudo_inverse<2>(V, Gn, Sn);
+  } else {
+    int j = 0;
+    for (int i = 1; i < 3; ++i)
+      if (Gn.col(i).squaredNorm() > Gn.col(j).squaredNorm()) j = i;
+    if (!(Gn.col(j).squaredNorm() > 0.0)) return Mat3::Zero();
+    Pn = reduced_pseudo_inverse<1>(Gn.col(j).normalized(), Gn, Sn);
   }
   return inv_norm.asDiagonal() * Pn * inv_norm.asDiagonal();
 }

@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <boost/math/tools/toms748_solve.hpp>
 
 #include "active_set.hpp"

@@ -2,6 +2,8 @@
 // do not depend on units, and bounded impulses for points that lie almost on one line.
 #include <algorithm>
 
+#include <Eigen/SVD>
+
 #include <gtest/gtest.h>
 
 #include "active_set.hpp"
@@ -56,6 +58,53 @@ TEST(ActiveSet, SmallAndLargePatchesShareTheLoadAlike) {
     const PointVector j = solve_active_set(cache, PointVector::Constant(4, -1.0),
                                            PointVector::Zero(4));
     for (int i = 0; i < 4; ++i) EXPECT_NEAR(j(i), 0.25, 1e-12) << "half size " << h;
+  }
+}
+
+/// K⁺ of K = D S Dᵀ through D P Dᵀ, against Eigen's SVD pseudo-inverse of the m×m K; the
+/// largest entry difference relative to K⁺'s largest entry.
+double pseudo_inverse_error(const std::vector<Vec3>& offsets, const Vec3& normal) {
+  ContactSide cube = unit_cube_side();
+  cube.inv_inertia = Vec3(5.0, 7.0, 3.0).asDiagonal();  // unequal axes: S with every term
+  Vec3 t1, t2;
+  t1 = normal.cross(std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).normalized();
+  t2 = normal.cross(t1);
+  const int n = static_cast<int>(offsets.size());
+  const NormalSystem sys =
+      make_normal_system(normal, t1, t2, offsets.data(), n, nullptr, &cube);
+  // The reference in long double: K's condition number reaches ~1e7 for a 1 mm patch.
+  using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+  const MatL Dl = sys.D.cast<long double>();
+  const MatL K = Dl * sys.S.cast<long double>() * Dl.transpose();
+  const Eigen::JacobiSVD<MatL> svd(K, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix<long double, Eigen::Dynamic, 1> inv_sigma = svd.singularValues();
+  for (Eigen::Index i = 0; i < inv_sigma.size(); ++i)
+    inv_sigma(i) = inv_sigma(i) > 1e-12L * svd.singularValues()(0) ? 1.0L / inv_sigma(i) : 0.0L;
+  const Eigen::MatrixXd want =
+      (svd.matrixV() * inv_sigma.asDiagonal() * svd.matrixU().transpose()).cast<double>();
+  const Eigen::MatrixXd D = sys.D;
+  const Eigen::MatrixXd got = D * pseudo_inverse_factor(sys.D, sys.S) * D.transpose();
+  return (got - want).cwiseAbs().maxCoeff() / want.cwiseAbs().maxCoeff();
+}
+
+// Points on one line (an edge against a face) and a single point give G = DᵀD of rank two
+// and one: the factor is built on G's range without an eigendecomposition, and D P Dᵀ is still
+// the pseudo-inverse of K, at any tilt of the line and any size of the patch (the
+// eigendecomposition this replaced was 3e-11 off for the 1 mm edge).
+TEST(ActiveSet, PointsOnOneLineAndSinglePointsGetThePseudoInverse) {
+  const Vec3 normal = Vec3(0.3, 1.0, -0.2).normalized();
+  Vec3 along = normal.cross(Vec3(0.7, 0.1, 0.4)).normalized();
+  for (const double size : {1.0, 1e-3}) {
+    const Vec3 base = size * Vec3(0.2, -0.1, 0.3);
+    const std::vector<std::vector<Vec3>> cases{
+        {base, base + size * along},                                           // an edge
+        {base, base + 0.3 * size * along, base - 0.9 * size * along},          // three on it
+        {base, base + 0.5 * size * along, base, base + 0.5 * size * along},    // repeated
+        {base},                                                                // a corner
+        {Vec3::Zero()},                                                        // at the origin
+        {base, base}};                                                         // one, twice
+    for (std::size_t c = 0; c < cases.size(); ++c)
+      EXPECT_LT(pseudo_inverse_error(cases[c], normal), 1e-12) << "case " << c << ", " << size;
   }
 }
 
