@@ -22,6 +22,14 @@ using PointVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxActiveSetPoi
 using PlaneCoordinates =
     Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor, kMaxActiveSetPoints, 3>;
 
+/// Two unit tangents completing n to a right-handed basis, chosen the same way every step so
+/// accumulated friction impulses stay meaningful for warm starting.
+inline void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  const Vec3 ref = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+  t1 = n.cross(ref).normalized();
+  t2 = n.cross(t1);
+}
+
 /// One side of a contact seen by the normal impulses: a body (or nothing, for the floor).
 struct ContactSide {
   double inv_mass = 0.0;            ///< 1/kg.
@@ -136,11 +144,10 @@ inline Mat3 pseudo_inverse_factor_of_gram(const Mat3& G, const Mat3& S) {
   const double trace = Gn.trace();
   Mat3 Pn;
   if (cross[k].norm() > kRank * trace * trace) {
-    const Vec3 u = cross[k].normalized();  // normal to the range
-    const Vec3 ref = std::abs(u.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    Vec3 t1, t2;  // the range: the plane normal to the cross product
+    tangents(cross[k].normalized(), t1, t2);
     Eigen::Matrix<double, 3, 2> V;
-    V.col(0) = u.cross(ref).normalized();
-    V.col(1) = u.cross(V.col(0));
+    V << t1, t2;
     Pn = reduced_pseudo_inverse<2>(V, Gn, Sn);
   } else {
     int j = 0;

@@ -4,7 +4,6 @@
 #include <atomic>
 #include <cmath>
 
-
 #include "active_set.hpp"
 #include "floor_contact.hpp"
 #include "solver.hpp"

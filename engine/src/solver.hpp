@@ -12,14 +12,6 @@
 
 namespace tumble {
 
-/// Two unit tangents completing n to a right-handed basis, chosen the same way every step so
-/// accumulated friction impulses stay meaningful for warm starting.
-inline void tangents(const Vec3& n, Vec3& t1, Vec3& t2) {
-  const Vec3 ref = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  t1 = n.cross(ref).normalized();
-  t2 = n.cross(t1);
-}
-
 /// A body's velocities during one contact's sweep (m/s, rad/s).
 struct Motion {
   Vec3 v;

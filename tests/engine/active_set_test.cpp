@@ -61,14 +61,13 @@ TEST(ActiveSet, SmallAndLargePatchesShareTheLoadAlike) {
   }
 }
 
-/// K⁺ of K = D S Dᵀ through D P Dᵀ, against Eigen's SVD pseudo-inverse of the m×m K; the
+/// K⁺ of K = D S Dᵀ through D P Dᵀ, against a long-double SVD pseudo-inverse of the m×m K; the
 /// largest entry difference relative to K⁺'s largest entry.
 double pseudo_inverse_error(const std::vector<Vec3>& offsets, const Vec3& normal) {
   ContactSide cube = unit_cube_side();
   cube.inv_inertia = Vec3(5.0, 7.0, 3.0).asDiagonal();  // unequal axes: S with every term
   Vec3 t1, t2;
-  t1 = normal.cross(std::abs(normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).normalized();
-  t2 = normal.cross(t1);
+  tangents(normal, t1, t2);
   const int n = static_cast<int>(offsets.size());
   const NormalSystem sys =
       make_normal_system(normal, t1, t2, offsets.data(), n, nullptr, &cube);
@@ -93,7 +92,7 @@ double pseudo_inverse_error(const std::vector<Vec3>& offsets, const Vec3& normal
 // eigendecomposition this replaced was 3e-11 off for the 1 mm edge).
 TEST(ActiveSet, PointsOnOneLineAndSinglePointsGetThePseudoInverse) {
   const Vec3 normal = Vec3(0.3, 1.0, -0.2).normalized();
-  Vec3 along = normal.cross(Vec3(0.7, 0.1, 0.4)).normalized();
+  const Vec3 along = normal.cross(Vec3(0.7, 0.1, 0.4)).normalized();
   for (const double size : {1.0, 1e-3}) {
     const Vec3 base = size * Vec3(0.2, -0.1, 0.3);
     const std::vector<std::vector<Vec3>> cases{
