@@ -405,17 +405,98 @@ void glide_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, doubl
   if (lowest < floor_y) s.x.y() += floor_y - lowest;
 }
 
+/// Vertical speed of vertex i (offset r from the centre, world) of a body moving at v, ω:
+/// (v + ω × r)_y, m/s.
+double vertex_speed_y(const Vec3& v, const Vec3& w, const Vec3& r) {
+  return v.y() + w.z() * r.x() - w.x() * r.z();
+}
+
+/// Root in (0, 1) of the quartic q(τ) = p(τ) + k τ²(τ − 1)², p the cubic Hermite interpolant of
+/// heights y0 > 0, y1 < 0 with slopes d0, d1 (per unit τ) at τ = 0 and 1 (the quartic term keeps
+/// those four values): Newton on q, kept inside its sign bracket by bisection (Numerical
+/// Recipes' rtsafe); no trajectory evaluation. `slope` is q's there.
+double hermite_root(double y0, double d0, double y1, double d1, double k, double& slope) {
+  // q(τ) = y0 + d0 τ + c2 τ² + c3 τ³ + k τ⁴ with q(1) = y1, q'(1) = d1.
+  const double c2 = 3.0 * (y1 - y0) - 2.0 * d0 - d1 + k;
+  const double c3 = 2.0 * (y0 - y1) + d0 + d1 - 2.0 * k;
+  double lo = 0.0, hi = 1.0;
+  double t = y0 / (y0 - y1);  // the chord's root
+  for (int n = 0; n < 60; ++n) {
+    const double q = y0 + t * (d0 + t * (c2 + t * (c3 + t * k)));
+    (q > 0.0 ? lo : hi) = t;
+    slope = d0 + t * (2.0 * c2 + t * (3.0 * c3 + 4.0 * t * k));
+    double next = slope < 0.0 ? t - q / slope : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - t) <= 1e-15) return next;
+    t = next;
+  }
+  return t;
+}
+
+/// Fourth time derivative of the height of a point at offset r (world) on a body turning at ω
+/// about a fixed axis: |ω|⁴ times r's component normal to ω, its y (m/s⁴).
+double turn_fourth_derivative_y(const Vec3& w, const Vec3& r) {
+  const double w2 = w.squaredNorm();
+  return w2 * (w2 * r.y() - r.dot(w) * w.y());
+}
+
+/// A first guess at the time of impact (s, in (0, h)) and how far it may be off (s).
+struct ImpactGuess {
+  double time = 0.0;
+  double error = 0.0;
+};
+
+/// The guess of time_of_impact: the earliest root among the vertices of `mask` that end below
+/// the floor, each from the cubic Hermite interpolant of its height and vertical speed at both
+/// ends of the step (states s and end). Its error bound: a cubic Hermite interpolant over h is
+/// off by at most h⁴/384 max|y⁗|; the centre's height is a parabola (y⁗ = 0) and a vertex's
+/// turn about it has |y⁗| ≤ 16 Ω⁴ r, where Ω² = 2E / I_min bounds |ω|² in torque-free motion
+/// (E the rotational energy; 16 a generous constant for the derivatives of ω a general body
+/// adds), divided by the speed at the root; never below 1e-13 h, the evaluations' own
+/// round-off. The bound only sets the bracket tried first, which two evaluations then check.
+ImpactGuess hermite_time_of_impact(const BodyState& s, const BodyState& end,
+                                   const BodyConstants& c, double floor_y, double h,
+                                   unsigned mask) {
+  const HalfEdges e0(s, c), e1(end, c);
+  const Vec3 v0 = c.inv_mass * s.P, v1 = c.inv_mass * end.P;
+  const Vec3 w0 = angular_velocity(s, c), w1 = angular_velocity(end, c);
+  double earliest = 1.0, speed = 0.0;
+  for (int i = 0; i < 8; ++i) {
+    if (!(mask & (1u << i))) continue;
+    const double y1 = end.x.y() + e1.vertex_y(i) - floor_y;
+    const double y0 = s.x.y() + e0.vertex_y(i) - floor_y;
+    if (y1 >= 0.0 || y0 <= 0.0) continue;
+    const Vec3 r0 = e0.vertex(i), r1 = e1.vertex(i);
+    const double d0 = h * vertex_speed_y(v0, w0, r0);
+    const double d1 = h * vertex_speed_y(v1, w1, r1);
+    // The cubic's error y⁗ h⁴ τ²(τ − 1)² / 24 with the turn's y⁗ (the mean of both ends):
+    // without it every guess came late, the lowest vertex's y⁗ being negative.
+    const double y4 = 0.5 * (turn_fourth_derivative_y(w0, r0) + turn_fourth_derivative_y(w1, r1));
+    const double h2 = h * h;
+    double slope = 0.0;
+    const double root = hermite_root(y0, d0, y1, d1, y4 * h2 * h2 / 24.0, slope);
+    if (root < earliest) earliest = root, speed = std::abs(slope) / h;
+  }
+  if (speed == 0.0) return {h, INFINITY};  // no vertex of the mask ends below the floor
+  const double omega2 = w0.dot(s.L) * c.inv_inertia.maxCoeff();  // 2E / I_min ≥ |ω|²
+  const double y4_bound = 16.0 * omega2 * omega2 * c.bounding_radius;
+  const double h4 = h * h * h * h;
+  const double error = h4 / 384.0 * y4_bound / speed;
+  return {earliest * h, std::max(error, 1e-13 * h)};
+}
+
 /// Earliest time in [0, h] at which a vertex of `mask` reaches the floor (it is above at 0
-/// and some vertex of the mask is below at h). Returns the non-penetrating end of the final
-/// bracket, so a body is never left inside the floor, and sets `at` to the body's state then.
+/// and some vertex of the mask is below at h, in the state `end`). Returns the non-penetrating
+/// end of the final bracket, so a body is never left inside the floor, and sets `at` to the
+/// body's state then.
 ///
 /// Both searches end on a time they evaluated with the body above the floor (the lower end of
 /// the bracket), so that evaluation's state is kept rather than computed again: the latest
 /// time evaluated above the floor is that end. One trajectory evaluation saved per impact,
 /// the same bits.
-double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef& w,
-                      double floor_y, double h, unsigned mask, double height_at_h,
-                      int& evaluations, BodyState& at) {
+double time_of_impact(const BodyState& s, const BodyState& end, const BodyConstants& c,
+                      const WorldDef& w, double floor_y, double h, unsigned mask,
+                      double height_at_h, int& evaluations, BodyState& at) {
   double at_t = 0.0;
   at = s;
   auto height_of = [&](const BodyState& st) {
@@ -441,17 +522,37 @@ double time_of_impact(const BodyState& s, const BodyConstants& c, const WorldDef
     }
     return state_at(lo);
   }
+  const double tol = w.toi_tolerance;
+  // Why a guess first: both ends of the step are known states, and each vertex's height and
+  // vertical speed there fix its cubic Hermite interpolant. Under gravity alone a vertex's
+  // height is a parabola plus the turn of the body, so over a step of 1/240 s at 3 rad/s the
+  // interpolant's root is off by ~1e-11 s, inside the tolerance (1e-9 s in the bundled scenes).
+  // Two evaluations, at its root ± its error bound (at most tol/2), then bracket the impact;
+  // TOMS 748 took 4.4 on average for the landing of 1,000 general boxes. When they do not (the
+  // lowest vertex changes within the step, a tolerance below the guess's error), the one that
+  // failed narrows the bracket TOMS 748 starts from.
+  double lo = 0.0, hi = h, y_lo = height_of(s), y_hi = height_at_h;
+  const ImpactGuess guess = hermite_time_of_impact(s, end, c, floor_y, h, mask);
+  const double half_width = std::min(guess.error, 0.45 * tol);
+  const double a = guess.time - half_width, b = guess.time + half_width;
+  if (a > 0.0 && b < h) {
+    const double ya = height(a);
+    if (ya < 0.0) {
+      hi = a, y_hi = ya;
+    } else {
+      const double yb = height(b);
+      if (yb < 0.0) return state_at(a);
+      lo = b, y_lo = yb;
+    }
+  }
   // TOMS 748 (Alefeld, Potra & Shi 1995) on the lowest-vertex height along the trajectory:
   // cubic inverse interpolation with bracketing, a few evaluations where bisection takes
-  // log2(h / tolerance). The lower end keeps the sign of height(0) > 0.
-  // The start is s itself: its height needs no trajectory evaluation (advancing by 0 s
-  // gives s back to the bit).
-  const double h0 = height_of(s);
+  // log2(h / tolerance). The lower end keeps the sign of height(lo) ≥ 0. The step's start is
+  // s itself: its height needs no trajectory evaluation (advancing by 0 s gives s back to the
+  // bit).
   std::uintmax_t max_iter = 100;
-  const double tol = w.toi_tolerance;
   const auto bracket = boost::math::tools::toms748_solve(
-      height, 0.0, h, h0, height_at_h, [tol](double a, double b) { return b - a <= tol; },
-      max_iter);
+      height, lo, hi, y_lo, y_hi, [tol](double x, double y) { return y - x <= tol; }, max_iter);
   return state_at(bracket.first);
 }
 
@@ -557,7 +658,7 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     const double masked_end =
         mask == 0xFF ? end_height : lowest_masked_y(next, c, mask) - floor_y;
     BodyState at_impact;
-    const double t = time_of_impact(s, c, w, floor_y, remaining, mask, masked_end,
+    const double t = time_of_impact(s, next, c, w, floor_y, remaining, mask, masked_end,
                                     result.toi_iterations, at_impact);
     s = at_impact;
     resolve_floor_impact(s, c, floor_y, c.restitution, c.friction, vrest);
