@@ -320,10 +320,16 @@ void filter_pairs(StepContext& ctx) {
   const std::span<const BodyPair> pairs(k.fat_pairs);
   const std::uint8_t* active = k.active.data();
   const Aabb* boxes = k.boxes.data();
+  // Every pair is written and the count moves on only for those kept: no branch on the test.
   auto keep = [&](std::size_t begin, std::size_t end, std::vector<BodyPair>& out) {
-    for (const BodyPair& p : pairs.subspan(begin, end - begin))
-      if ((active[p.first] || active[p.second]) && overlaps(boxes[p.first], boxes[p.second]))
-        out.push_back(p);
+    std::size_t count = out.size();
+    out.resize(count + (end - begin));
+    BodyPair* to = out.data();
+    for (const BodyPair& p : pairs.subspan(begin, end - begin)) {
+      to[count] = p;
+      count += ((active[p.first] | active[p.second]) != 0) & overlaps(boxes[p.first], boxes[p.second]);
+    }
+    out.resize(count);
   };
   const std::size_t n = pairs.size();
   const std::size_t ranges = std::min<std::size_t>(4 * ctx.pool.size(), n / kGrain);

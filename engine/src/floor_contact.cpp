@@ -427,7 +427,7 @@ double hermite_root(double y0, double d0, double y1, double d1, double k, double
     slope = d0 + t * (2.0 * c2 + t * (3.0 * c3 + 4.0 * t * k));
     double next = slope < 0.0 ? t - q / slope : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - t) <= 1e-15) return next;
+    if (std::abs(next - t) <= 1e-14) return next;  // 1e-14 h: below the guess's error floor
     t = next;
   }
   return t;
