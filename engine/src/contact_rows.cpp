@@ -74,7 +74,7 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
 
 }  // namespace
 
-void Solver::prepare(Contact& c, std::size_t slot, double dt) {
+void Solver::prepare(Contact& c, std::size_t slot, double dt, const SolverSettings& s) {
   SolverBody* a = body(c.a);
   SolverBody* b = body(c.b);
   ContactRows& block = rows_[slot];  // sized by the caller
@@ -103,7 +103,7 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt) {
                      r.ang_b.dot(r.inv_b);  // n·K n, 1/kg
     r.normal_mass = 1.0 / k;
     r.target = target_of(p, dt);
-    r.separation = p.separation;
+    r.split_target = split_target_of(p, dt, s);
     impulses.normal[i] = p.normal_impulse;
     impulses.pseudo[i] = 0.0;
   }

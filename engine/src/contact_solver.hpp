@@ -98,7 +98,7 @@ struct PointRows {
   Vec3 inv_b;          ///< I_b⁻¹ (rb × n), 1/(kg·m).
   double normal_mass;  ///< 1 / (n·K n), kg.
   double target;       ///< Normal speed the point must reach (Solver::target_of), m/s.
-  double separation;   ///< ContactPoint::separation, m (the split impulse's target).
+  double split_target; ///< Normal pseudo speed the split impulse drives the point to, m/s.
 };
 
 /// A contact's three friction rows: t1 and t2 at the patch's centre of pressure, the twist

@@ -68,7 +68,7 @@ class Solver {
   /// The step's rows of contact `c` in rows slot `slot`: the points' offsets and normal rows,
   /// the normal block, the patch friction and the accumulated impulses (contact_rows.cpp).
   /// Thread-safe across contacts.
-  void prepare(Contact& c, std::size_t slot, double dt);
+  void prepare(Contact& c, std::size_t slot, double dt, const SolverSettings& s);
   /// Puts the accumulated impulses of rows slot `slot` back into its contact c.
   void store_impulses(Contact& c, std::size_t slot) const;
 
@@ -100,7 +100,7 @@ class Solver {
   /// One sequential-impulse sweep of rows slot `slot`: patch friction, then the normal block.
   void solve_velocity(std::size_t slot);
   /// One split-impulse sweep of rows slot `slot` on the pseudo velocities.
-  void solve_position(std::size_t slot, const SolverSettings& s, double dt);
+  void solve_position(std::size_t slot);
   /// The solver body at solver index k, or the fixed stand-in for the floor (k < 0).
   SolverBody& at(std::int32_t k) { return k < 0 ? fixed_ : sb_[k]; }
   /// Relative normal velocity of b over a at a point (row r, normal n), m/s. Body: anything
@@ -131,6 +131,14 @@ class Solver {
   /// step, a touching one may not approach (its penetration is the split impulse's job).
   static double target_of(const ContactPoint& p, double dt) {
     return p.separation > 0.0 ? -p.separation / dt : 0.0;
+  }
+  /// Normal pseudo speed the split impulse drives a point to: a gap may close within the step
+  /// but no more (a touching point may not be pushed deeper by the correction of another
+  /// contact, a box pressed into the floor by the one above it), and a penetration beyond the
+  /// slop shrinks by the position gain, m/s.
+  static double split_target_of(const ContactPoint& p, double dt, const SolverSettings& s) {
+    return p.separation > 0.0 ? -p.separation / dt
+                              : s.position_gain * std::max(-p.separation - s.slop, 0.0) / dt;
   }
 
  private:
