@@ -1,6 +1,7 @@
 /// Sweep and prune: the pairs of overlapping boxes (find_pairs, declared in broad_phase.hpp).
 /// The broad-phase stage calls it on its fat boxes; initial_pairs on the boxes as placed.
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "broad_phase.hpp"
@@ -119,14 +120,26 @@ std::size_t sweep_slabs(const SweepScratch& scratch, std::size_t first, std::siz
   const std::vector<std::uint32_t>& offset = scratch.slab_offset;
   std::size_t s = static_cast<std::size_t>(
       std::upper_bound(offset.begin(), offset.end(), first) - offset.begin() - 1);
+  // Each partner found goes into `hits` and the count moves on only for those that overlap:
+  // no branch on the test, which a pile's sweep takes at random for one test in five or six.
+  constexpr std::size_t kHits = 64;
+  std::array<std::uint32_t, kHits> hits;
   for (std::size_t i = first; i < last && out.size() <= max_pairs; ++i) {
     while (i >= offset[s + 1]) ++s;
     const SlabItem& a = items[i];
-    for (std::size_t j = i + 1; j < offset[s + 1] && items[j].start <= a.end; ++j) {
+    const std::size_t end = offset[s + 1];
+    std::size_t found = 0;
+    for (std::size_t j = i + 1; j < end && items[j].start <= a.end; ++j) {
       ++tests;
-      if (overlaps(a.box, items[j].box) && std::max<std::size_t>(a.first, items[j].first) == s)
-        add_pair(out, a.id, items[j].id);
+      const SlabItem& b = items[j];
+      hits[found] = b.id;
+      found += overlaps(a.box, b.box) & (std::max(a.first, b.first) == s);
+      if (found == kHits) {
+        for (std::uint32_t id : hits) add_pair(out, a.id, id);
+        found = 0;
+      }
     }
+    for (std::size_t h = 0; h < found; ++h) add_pair(out, a.id, hits[h]);
   }
   return tests;
 }
