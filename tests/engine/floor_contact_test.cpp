@@ -386,13 +386,15 @@ World spinning_drop(const std::string& size, const std::string& spin, ToiMethod 
 }
 
 // The time of impact starts from the cubic Hermite interpolant of each vertex's height between
-// the step's two known ends (with the turn's fourth-derivative term) and checks it with two
-// evaluations, where TOMS 748 alone took about four. It must stay as exact: the state after each
-// body's first impact step matches a bisection to 1e-14 s to what the 1e-9 s tolerance allows.
-TEST(TimeOfImpact, HermiteGuessFindsSpinningImpactsInTwoEvaluations) {
+// the step's two known ends (with the turn's fourth-derivative term), checks it with two
+// evaluations and closes the bracket with a third, where TOMS 748 alone took about four. The
+// time comes out to round-off, not just to the 1e-9 s tolerance: the state after each body's
+// first impact step matches a bisection to 1e-14 s.
+TEST(TimeOfImpact, HermiteGuessFindsSpinningImpactsInThreeEvaluations) {
   const char* sizes[] = {"[0.4, 0.4, 0.4]", "[0.3, 0.5, 0.7]", "[0.2, 0.6, 0.45]"};
   const char* spins[] = {"[2, -3, 1.5]", "[-1, 0.5, 3]", "[3, 3, -2]", "[0, 0.2, 0]"};
   std::uint64_t impacts = 0, evaluations = 0;
+  double worst_x = 0.0, worst_angle = 0.0, worst_v = 0.0;
   for (const char* size : sizes) {
     for (const char* spin : spins) {
       World world = spinning_drop(size, spin, ToiMethod::root, 1e-9);
@@ -409,18 +411,22 @@ TEST(TimeOfImpact, HermiteGuessFindsSpinningImpactsInTwoEvaluations) {
         const BodyState& s = world.body(0).s;
         const BodyState& r = reference.body(0).s;
         EXPECT_EQ(reference.total_impacts(), world.total_impacts()) << size << spin;
-        EXPECT_LT((s.x - r.x).norm(), 5e-8) << size << spin;
-        EXPECT_LT(rotation_angle_between(s.R, r.R), 5e-8) << size << spin;
-        EXPECT_LT((s.P - r.P).norm(), 5e-7 * world.body(0).c.mass) << size << spin;
+        worst_x = std::max(worst_x, (s.x - r.x).norm());
+        worst_angle = std::max(worst_angle, rotation_angle_between(s.R, r.R));
+        worst_v = std::max(worst_v, (s.P - r.P).norm() / world.body(0).c.mass);
       }
       EXPECT_FALSE(first) << size << spin << ": no impact";
     }
   }
   ASSERT_GT(impacts, 50u);
   const double per_impact = static_cast<double>(evaluations) / static_cast<double>(impacts);
-  EXPECT_LT(per_impact, 2.3);
+  EXPECT_LT(per_impact, 3.2);
+  EXPECT_LT(worst_x, 1e-11);
+  EXPECT_LT(worst_angle, 1e-11);
+  EXPECT_LT(worst_v, 1e-10);
   std::cout << "[ measured ] " << impacts << " impacts, " << per_impact
-            << " trajectory evaluations each\n";
+            << " trajectory evaluations each; after the first impact, off the bisection by "
+            << worst_x << " m, " << worst_angle << " rad, " << worst_v << " m/s\n";
 }
 
 }  // namespace
