@@ -17,7 +17,11 @@ constexpr int kMaxImpactsPerStep = 32;
 constexpr double kSlop = 1e-12;          // m: deeper than this below the floor is penetration.
 constexpr double kSimultaneous = 1e-9;   // m: vertices this close to the lowest hit together.
 constexpr double kContactBand = 1e-6;    // m: vertices this close to the floor are touching.
-constexpr double kGuessRoundOff = 1e-14;  // of the step: the time of impact's round-off.
+// Of the step: the narrowest bracket tried around the guess (a body that does not turn, whose
+// guess is exact but for round-off), and how far before the secant's root the closing
+// evaluation goes (1e-15 of the step let round-off in the heights turn it down at times).
+constexpr double kGuessRoundOff = 1e-15;
+constexpr double kClosingOffset = 1e-14;
 constexpr int kMaxPoints = kMaxActiveSetPoints;  // a box has 8 vertices
 
 
@@ -532,7 +536,7 @@ double time_of_impact(const BodyState& s, const BodyState& end, const BodyConsta
   // one that failed narrows the bracket TOMS 748 starts from.
   double lo = 0.0, hi = h, y_lo = height_of(s), y_hi = height_at_h;
   const ImpactGuess guess = hermite_time_of_impact(s, end, c, floor_y, h, mask);
-  const double round_off = kGuessRoundOff * h;
+  const double offset = kClosingOffset * h;
   const double half_width = std::min(guess.error, 0.45 * tol);
   const double a = guess.time - half_width, b = guess.time + half_width;
   if (a > 0.0 && b < h) {
@@ -547,8 +551,8 @@ double time_of_impact(const BodyState& s, const BodyState& end, const BodyConsta
         // the time comes out to round-off, as TOMS 748's did (its last bracket was mostly far
         // inside the tolerance; the seed scene's final position is 2e-7 m from the
         // reference with it, 1e-6 m when the guess's bracket ended the search).
-        const double closer = a + (b - a) * (ya / (ya - yb)) - round_off;
-        if (half_width > round_off && closer > a && height(closer) >= 0.0)
+        const double closer = a + (b - a) * (ya / (ya - yb)) - offset;
+        if (half_width > offset && closer > a && height(closer) >= 0.0)
           return state_at(closer);
         return state_at(a);
       }
