@@ -327,7 +327,8 @@ void filter_pairs(StepContext& ctx) {
     BodyPair* to = out.data();
     for (const BodyPair& p : pairs.subspan(begin, end - begin)) {
       to[count] = p;
-      count += ((active[p.first] | active[p.second]) != 0) & overlaps(boxes[p.first], boxes[p.second]);
+      const bool awake = (active[p.first] | active[p.second]) != 0;
+      count += awake & overlaps(boxes[p.first], boxes[p.second]);
     }
     out.resize(count);
   };

@@ -432,7 +432,7 @@ double hermite_root(double y0, double d0, double y1, double d1, double k, double
     slope = d0 + t * (2.0 * c2 + t * (3.0 * c3 + 4.0 * t * k));
     double next = slope < 0.0 ? t - q / slope : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - t) <= 1e-15) return next;  // 1e-15 h: below the guess's error floor
+    if (std::abs(next - t) <= kGuessRoundOff) return next;  // τ is in units of the step
     t = next;
   }
   return t;
@@ -445,20 +445,21 @@ double turn_fourth_derivative_y(const Vec3& w, const Vec3& r) {
   return w2 * (w2 * r.y() - r.dot(w) * w.y());
 }
 
-/// A first guess at the time of impact (s, in (0, h)) and how far it may be off (s).
+/// A first guess at the time of impact and how far it may be off.
 struct ImpactGuess {
-  double time = 0.0;
-  double error = 0.0;
+  double time = 0.0;   ///< s, in (0, h]; h when no vertex ends below the floor.
+  double error = 0.0;  ///< Bound on |time − the impact's time|, s.
 };
 
 /// The guess of time_of_impact: the earliest root among the vertices of `mask` that end below
 /// the floor, each from the cubic Hermite interpolant of its height and vertical speed at both
-/// ends of the step (states s and end). Its error bound: a cubic Hermite interpolant over h is
-/// off by at most h⁴/384 max|y⁗|; the centre's height is a parabola (y⁗ = 0) and a vertex's
-/// turn about it has |y⁗| ≤ 16 Ω⁴ r, where Ω² = 2E / I_min bounds |ω|² in torque-free motion
-/// (E the rotational energy; 16 a generous constant for the derivatives of ω a general body
-/// adds), divided by the speed at the root; never below kGuessRoundOff h, near the
-/// evaluations' own round-off. The bound only sets the bracket tried first, which two evaluations then check.
+/// ends of the step (states s and end), plus its leading error term. The error bound is the
+/// cubic's alone, generous for the quartic: a cubic Hermite interpolant over h is off by at
+/// most h⁴/384 max|y⁗|; the centre's height is a parabola (y⁗ = 0) and a vertex's turn about
+/// it has |y⁗| ≤ 16 Ω⁴ r, where Ω² = 2E / I_min bounds |ω|² in torque-free motion (E the
+/// rotational energy; 16 a generous constant for the derivatives of ω a general body adds),
+/// divided by the speed at the root; never below kGuessRoundOff h, near the evaluations' own
+/// round-off. The bound only sets the bracket tried first, which evaluations then check.
 ImpactGuess hermite_time_of_impact(const BodyState& s, const BodyState& end,
                                    const BodyConstants& c, double floor_y, double h,
                                    unsigned mask) {
@@ -475,8 +476,10 @@ ImpactGuess hermite_time_of_impact(const BodyState& s, const BodyState& end,
     const double d0 = h * vertex_speed_y(v0, w0, r0);
     const double d1 = h * vertex_speed_y(v1, w1, r1);
     // The cubic's error y⁗ h⁴ τ²(τ − 1)² / 24 with the turn's y⁗ (the mean of both ends):
-    // without it every guess came late, the lowest vertex's y⁗ being negative.
-    const double y4 = 0.5 * (turn_fourth_derivative_y(w0, r0) + turn_fourth_derivative_y(w1, r1));
+    // without it one spinning cube's guess in five came late by more than the tolerance (the
+    // lowest vertex's y⁗ is negative: the true height lies below the cubic).
+    const double y4 =
+        0.5 * (turn_fourth_derivative_y(w0, r0) + turn_fourth_derivative_y(w1, r1));
     const double h2 = h * h;
     double slope = 0.0;
     const double root = hermite_root(y0, d0, y1, d1, y4 * h2 * h2 / 24.0, slope);
