@@ -10,19 +10,30 @@ std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
 }
 
 /// Starts each contact from the impulses its pair had last step (matched by key); each
-/// contact on its own, shared among the pool's threads.
+/// contact on its own, shared among the pool's threads. The contacts come in two sorted runs
+/// of keys (the floor's, then the box–box pairs'), as last step's sorted keys do, so each key
+/// is found by walking on from the one before; a binary search only where a run starts over.
+/// With a search for every contact, `contact_solve`'s own samples (the search was inlined
+/// there) were 1.0 % of `pile`'s, against 0.35 % with the walk (`perf`, the same bits).
 void warm_start(StepContext& ctx) {
+  using Entry = std::pair<std::uint64_t, std::uint32_t>;
   const ContactCache& cache = ctx.cache;
   std::span<Contact> contacts = ctx.scratch.contacts;
+  const std::span<const Entry> keys(cache.previous_keys);
   ctx.pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
+    auto at = keys.begin();
+    std::uint64_t last = 0;
     for (std::size_t i = begin; i < end; ++i) {
       Contact& c = contacts[i];
       const std::uint64_t key = pair_key(c.a, c.b);
-      const auto it = std::lower_bound(
-          cache.previous_keys.begin(), cache.previous_keys.end(), key,
-          [](const std::pair<std::uint64_t, std::uint32_t>& e, std::uint64_t k) { return e.first < k; });
-      if (it != cache.previous_keys.end() && it->first == key)
-        warm_start_from(c, cache.previous[it->second]);
+      if (i == begin || key < last) {
+        at = std::lower_bound(keys.begin(), keys.end(), key,
+                              [](const Entry& e, std::uint64_t k) { return e.first < k; });
+      } else {
+        while (at != keys.end() && at->first < key) ++at;
+      }
+      last = key;
+      if (at != keys.end() && at->first == key) warm_start_from(c, cache.previous[at->second]);
     }
   });
 }
