@@ -328,7 +328,7 @@ void filter_pairs(StepContext& ctx) {
     for (const BodyPair& p : pairs.subspan(begin, end - begin)) {
       to[count] = p;
       const bool awake = (active[p.first] | active[p.second]) != 0;
-      count += awake & overlaps(boxes[p.first], boxes[p.second]);
+      count += int{awake} & int{overlaps(boxes[p.first], boxes[p.second])};
     }
     out.resize(count);
   };

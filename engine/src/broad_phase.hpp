@@ -45,8 +45,9 @@ inline bool within(const QuietBound& q, const BodyState& s) {
 inline bool overlaps(const Aabb& a, const Aabb& b) {
   // All six comparisons, not the first that fails: in a pile a pair's boxes overlap or not
   // about as often as a coin falls, and each early exit was a mispredicted branch.
-  return (a.lo.x() <= b.hi.x()) & (a.lo.y() <= b.hi.y()) & (a.lo.z() <= b.hi.z()) &
-         (b.lo.x() <= a.hi.x()) & (b.lo.y() <= a.hi.y()) & (b.lo.z() <= a.hi.z());
+  int all = 1;
+  for (int i = 0; i < 3; ++i) all &= int{a.lo[i] <= b.hi[i]} & int{b.lo[i] <= a.hi[i]};
+  return all != 0;
 }
 
 /// A candidate pair of body indices, first < second.

@@ -133,7 +133,7 @@ std::size_t sweep_slabs(const SweepScratch& scratch, std::size_t first, std::siz
       ++tests;
       const SlabItem& b = items[j];
       hits[found] = b.id;
-      found += overlaps(a.box, b.box) & (std::max(a.first, b.first) == s);
+      found += int{overlaps(a.box, b.box)} & int{std::max(a.first, b.first) == s};
       if (found == kHits) {
         for (std::uint32_t id : hits) add_pair(out, a.id, id);
         found = 0;
