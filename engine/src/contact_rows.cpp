@@ -12,12 +12,13 @@ void prepare_friction(const Contact& c, ContactRows& rows, const SolverBody* a,
   FrictionRows& f = rows.friction;
   const Vec3& n = rows.dir[0];
   for (int k = 0; k < 3; ++k) {
-    f.ang_a[k] = !a ? Vec3::Zero() : k < 2 ? Vec3(ra0.cross(rows.dir[k + 1])) : n;
-    f.ang_b[k] = k < 2 ? Vec3(rb0.cross(rows.dir[k + 1])) : n;
-    f.inv_a[k] = a ? Vec3(a->inv_inertia * f.ang_a[k]) : Vec3::Zero();
-    f.inv_b[k] = b->inv_inertia * f.ang_b[k];
+    const Vec3 ang_a = !a ? Vec3::Zero() : k < 2 ? Vec3(ra0.cross(rows.dir[k + 1])) : n;
+    const Vec3 ang_b = k < 2 ? Vec3(rb0.cross(rows.dir[k + 1])) : n;
+    if (k < 2) f.ang_a[k] = ang_a, f.ang_b[k] = ang_b;
+    f.inv_a[k] = a ? Vec3(a->inv_inertia * ang_a) : Vec3::Zero();
+    f.inv_b[k] = b->inv_inertia * ang_b;
     const double linear = k < 2 ? (a ? a->inv_mass : 0.0) + b->inv_mass : 0.0;
-    f.mass[k] = 1.0 / (linear + f.ang_a[k].dot(f.inv_a[k]) + f.ang_b[k].dot(f.inv_b[k]));
+    f.mass[k] = 1.0 / (linear + ang_a.dot(f.inv_a[k]) + ang_b.dot(f.inv_b[k]));
   }
   f.radius = 0.0;
   for (int i = 0; i < c.count; ++i) {
@@ -28,15 +29,17 @@ void prepare_friction(const Contact& c, ContactRows& rows, const SolverBody* a,
 }
 
 /// The normal block of `rows` (ContactRows): the columns C, D, G, P G and P Dᵀ target, with
-/// K = D S Dᵀ formed from the columns (active_set.hpp: S = Σ Cᵀ I⁻¹ C + m⁻¹ e₀e₀ᵀ).
-void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
-                   const SolverBody* b, const Vec3& ra0, const Vec3& rb0) {
+/// K = D S Dᵀ formed from the columns (active_set.hpp: S = Σ Cᵀ I⁻¹ C + m⁻¹ e₀e₀ᵀ); `points`:
+/// the contact's point rows, their targets set.
+void prepare_block(const Contact& c, ContactRows& rows, const ContactPointRows& points,
+                   const SolverBody* a, const SolverBody* b, const Vec3& ra0, const Vec3& rb0) {
   const Vec3& n = rows.dir[0];
   rows.ca = {a ? Vec3(ra0.cross(n)) : Vec3::Zero(), rows.dir[1].cross(n), rows.dir[2].cross(n)};
-  rows.cb = {rb0.cross(n), rows.ca[1], rows.ca[2]};
+  rows.cb0 = rb0.cross(n);
+  const std::array<Vec3, 3> cb = {rows.cb0, rows.ca[1], rows.ca[2]};
   for (int k = 0; k < 3; ++k) {
     rows.inv_ca[k] = a ? Vec3(a->inv_inertia * rows.ca[k]) : Vec3::Zero();
-    rows.inv_cb[k] = b->inv_inertia * rows.cb[k];
+    rows.inv_cb[k] = b->inv_inertia * cb[k];
   }
   rows.D.resize(c.count, 3);
   // G = Σ dᵢ dᵢᵀ and Dᵀ target = Σ targetᵢ dᵢ, dᵢ = (1, αᵢ, βᵢ): by its sums (gram_of_sums).
@@ -51,7 +54,7 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
     saa += alpha * alpha;
     sab += alpha * beta;
     sbb += beta * beta;
-    const double target = rows.points[i].target;  // Solver::target_of, set by prepare
+    const double target = points[i].target;  // Solver::target_of, set by prepare
     dt_target(0) += target;
     dt_target(1) += target * alpha;
     dt_target(2) += target * beta;
@@ -59,12 +62,12 @@ void prepare_block(const Contact& c, ContactRows& rows, const SolverBody* a,
   rows.G = gram_of_sums(c.count, sa, sb, saa, sab, sbb);
   Mat3 P = Mat3::Zero();
   if (c.count == 1) {
-    P(0, 0) = rows.points[0].normal_mass;
+    P(0, 0) = points[0].normal_mass;
   } else {
     Mat3 S;
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
-        S(i, j) = rows.ca[i].dot(rows.inv_ca[j]) + rows.cb[i].dot(rows.inv_cb[j]);
+        S(i, j) = rows.ca[i].dot(rows.inv_ca[j]) + cb[i].dot(rows.inv_cb[j]);
     S(0, 0) += (a ? a->inv_mass : 0.0) + b->inv_mass;
     P = pseudo_inverse_factor_of_gram(rows.G, S);
   }
@@ -78,6 +81,7 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt, const SolverSettin
   SolverBody* a = body(c.a);
   SolverBody* b = body(c.b);
   ContactRows& block = rows_[slot];  // sized by the caller
+  ContactPointRows& points = point_rows_[slot];
   block.a = c.a == kStaticBody ? -1 : index_[c.a];
   block.b = index_[c.b];
   block.count = c.count;
@@ -94,7 +98,7 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt, const SolverSettin
     p.rb = p.position - bodies_[c.b].s.x;
     ra0 += p.ra;
     rb0 += p.rb;
-    PointRows& r = block.points[i];
+    PointRows& r = points[i];
     r.ang_a = a ? Vec3(p.ra.cross(normal)) : Vec3::Zero();
     r.inv_a = a ? Vec3(a->inv_inertia * r.ang_a) : Vec3::Zero();
     r.ang_b = p.rb.cross(normal);
@@ -109,7 +113,7 @@ void Solver::prepare(Contact& c, std::size_t slot, double dt, const SolverSettin
   }
   ra0 /= c.count;
   rb0 /= c.count;
-  prepare_block(c, block, a, b, ra0, rb0);
+  prepare_block(c, block, points, a, b, ra0, rb0);
   // Friction acts at the patch's centre of pressure (see solve_friction).
   double load = 0.0;
   Vec3 ra_load = Vec3::Zero(), rb_load = Vec3::Zero();

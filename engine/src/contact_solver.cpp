@@ -65,10 +65,11 @@ bool Solver::may_be_fast(std::size_t slot, double threshold) {
   // m/s at 1e6 m/s), so a point passed over is slower than the threshold in both.
   constexpr double kMargin = 1e-9;
   const ContactRows& rows = rows_[slot];
+  const ContactPointRows& points = point_rows_[slot];
   const SolverBody& a = at(rows.a);
   const SolverBody& b = at(rows.b);
   for (int i = 0; i < rows.count; ++i)
-    if (normal_speed(a, b, rows.dir[0], rows.points[i]) < kMargin - threshold) return true;
+    if (normal_speed(a, b, rows.dir[0], points[i]) < kMargin - threshold) return true;
   return false;
 }
 
@@ -77,8 +78,9 @@ void Solver::warm_start(std::size_t slot) {
   SolverBody& a = at(rows.a);
   SolverBody& b = at(rows.b);
   const ContactImpulses& impulses = impulses_[slot];
+  const ContactPointRows& points = point_rows_[slot];
   for (int i = 0; i < rows.count; ++i)
-    push(a, b, a.inv_mass, b.inv_mass, rows.dir[0], rows.points[i], impulses.normal[i]);
+    push(a, b, a.inv_mass, b.inv_mass, rows.dir[0], points[i], impulses.normal[i]);
   const FrictionRows& f = rows.friction;
   const std::array<double, 3>& j = impulses.friction;
   const Vec3 linear = j[0] * rows.dir[1] + j[1] * rows.dir[2];
@@ -115,6 +117,9 @@ void solve_friction(const ContactRows& rows, ContactImpulses& impulses, Motion& 
   const double old0 = total[0], old1 = total[1];
   double n0 = old0 - f.mass[0] * (rows.dir[1].dot(dv) + b.w.dot(f.ang_b[0]) - a.w.dot(f.ang_a[0]));
   double n1 = old1 - f.mass[1] * (rows.dir[2].dot(dv) + b.w.dot(f.ang_b[1]) - a.w.dot(f.ang_a[1]));
+  // The twist's angular rows are n on both bodies (the floor's w is zero: a.w·n is +0 there,
+  // as a.w·0 was when the floor's row was stored as zero).
+  const Vec3& n = rows.dir[0];
   const double len = std::sqrt(n0 * n0 + n1 * n1);
   if (len > limit) {
     const double scale = len > 0.0 ? limit / len : 0.0;
@@ -128,7 +133,7 @@ void solve_friction(const ContactRows& rows, ContactImpulses& impulses, Motion& 
   if (f.radius > 0.0) {
     const double old2 = total[2];
     const double twist_limit = limit * f.radius;
-    total[2] = std::clamp(old2 - f.mass[2] * (b.w.dot(f.ang_b[2]) - a.w.dot(f.ang_a[2])),
+    total[2] = std::clamp(old2 - f.mass[2] * (b.w.dot(n) - a.w.dot(n)),
                           -twist_limit, twist_limit);
     j2 = total[2] - old2;
   }
@@ -157,7 +162,7 @@ bool solve_normal_block(const ContactRows& rows, ContactImpulses& impulses, Moti
                         double ma, double mb) {
   const int n = N > 0 ? N : rows.count;
   const Vec3 wr = b.w - a.w;
-  const Vec3 y(rows.dir[0].dot(b.v - a.v) + b.w.dot(rows.cb[0]) - a.w.dot(rows.ca[0]),
+  const Vec3 y(rows.dir[0].dot(b.v - a.v) + b.w.dot(rows.cb0) - a.w.dot(rows.ca[0]),
                wr.dot(rows.ca[1]), wr.dot(rows.ca[2]));
   const Vec3 z = rows.Pt - rows.PG * y;
   std::array<double, kMaxContactPoints> next{};
@@ -182,14 +187,14 @@ bool solve_normal_block(const ContactRows& rows, ContactImpulses& impulses, Moti
 
 /// The sweep of one contact on velocities held in locals.
 template <int N>
-void solve_velocity_rows(const ContactRows& rows, ContactImpulses& impulses, Motion& a,
-                         Motion& b, double ma, double mb) {
+void solve_velocity_rows(const ContactRows& rows, const ContactPointRows& points,
+                         ContactImpulses& impulses, Motion& a, Motion& b, double ma, double mb) {
   solve_friction<N>(rows, impulses, a, b, ma, mb);
   const int n = N > 0 ? N : rows.count;
   // One point: the clamped sweep below is the block step.
   if (n > 1 && solve_normal_block<N>(rows, impulses, a, b, ma, mb)) return;
   for (int i = 0; i < n; ++i) {
-    const PointRows& r = rows.points[i];
+    const PointRows& r = points[i];
     const double vn = Solver::normal_speed(a, b, rows.dir[0], r);
     double& impulse = impulses.normal[i];
     const double next_i = std::max(0.0, impulse - r.normal_mass * (vn - r.target));
@@ -201,13 +206,13 @@ void solve_velocity_rows(const ContactRows& rows, ContactImpulses& impulses, Mot
 
 /// The sweep of one contact of N points (0: any count) on bodies a and b.
 template <int N>
-void sweep_contact(const ContactRows& rows, ContactImpulses& impulses, SolverBody& body_a,
-                   SolverBody& body_b) {
+void sweep_contact(const ContactRows& rows, const ContactPointRows& points,
+                   ContactImpulses& impulses, SolverBody& body_a, SolverBody& body_b) {
   // The two bodies' velocities in locals for the whole contact: the compiler keeps them in
   // registers instead of storing them after every row (a third of the sweep's instructions).
   Motion a{body_a.v, body_a.w}, b{body_b.v, body_b.w};
   const double ma = body_a.inv_mass, mb = body_b.inv_mass;
-  solve_velocity_rows<N>(rows, impulses, a, b, ma, mb);
+  solve_velocity_rows<N>(rows, points, impulses, a, b, ma, mb);
   if (ma > 0.0) body_a.v = a.v, body_a.w = a.w;  // not the floor, which a colour's contacts share
   body_b.v = b.v;
   body_b.w = b.w;
@@ -225,6 +230,8 @@ void sweep_contact(const ContactRows& rows, ContactImpulses& impulses, SolverBod
 // instead of penetrating first.
 void Solver::solve_velocity(std::size_t slot) {
   const ContactRows& rows = rows_[slot];
+  const ContactPointRows& points = point_rows_[slot];
+  ContactImpulses& impulses = impulses_[slot];
   SolverBody& a = at(rows.a);
   SolverBody& b = at(rows.b);
   // A point count known when compiling unrolls the per-point loops and drops their bounds
@@ -232,11 +239,11 @@ void Solver::solve_velocity(std::size_t slot) {
   // 10 % fewer instructions. Each count is its own function with its own locals; one set of
   // locals shared by the counts' inlined bodies went to the stack and cost 40 % more.
   switch (rows.count) {
-    case 1: return sweep_contact<1>(rows, impulses_[slot], a, b);
-    case 2: return sweep_contact<2>(rows, impulses_[slot], a, b);
-    case 3: return sweep_contact<3>(rows, impulses_[slot], a, b);
-    case 4: return sweep_contact<4>(rows, impulses_[slot], a, b);
-    default: return sweep_contact<0>(rows, impulses_[slot], a, b);
+    case 1: return sweep_contact<1>(rows, points, impulses, a, b);
+    case 2: return sweep_contact<2>(rows, points, impulses, a, b);
+    case 3: return sweep_contact<3>(rows, points, impulses, a, b);
+    case 4: return sweep_contact<4>(rows, points, impulses, a, b);
+    default: return sweep_contact<0>(rows, points, impulses, a, b);
   }
 }
 
@@ -264,12 +271,13 @@ NormalSystem Solver::normal_system_of(const Contact& c, const SolverBody* a,
 // correction adds no energy (Baumgarte's bias would make stacks bounce).
 void Solver::solve_position(std::size_t slot) {
   const ContactRows& rows = rows_[slot];
+  const ContactPointRows& points = point_rows_[slot];
   std::array<double, kMaxContactPoints>& pseudo = impulses_[slot].pseudo;
   SolverBody& a = at(rows.a);
   SolverBody& b = at(rows.b);
   const Vec3& n = rows.dir[0];
   for (int i = 0; i < rows.count; ++i) {
-    const PointRows& r = rows.points[i];
+    const PointRows& r = points[i];
     // Pseudo velocities obey the contacts too (Solver::split_target_of, found once in prepare:
     // the separations are the step start's; `pile`'s 3 s, 192.5 M → 181.6 M instructions here).
     const double target = r.split_target;
@@ -487,6 +495,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   const bool coloured = colours.count() > 0;
   auto contact_at = [&](std::size_t slot) { return coloured ? colours.order[slot] : slot; };
   if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
+  if (scratch.point_rows.size() < contacts.size()) scratch.point_rows.resize(contacts.size());
   if (scratch.impulses.size() < contacts.size()) scratch.impulses.resize(contacts.size());
   // Whether any point is deeper than the slop is found while each contact is in cache; the
   // separations are the step start's and the solve does not change them.

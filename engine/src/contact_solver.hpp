@@ -102,16 +102,16 @@ struct PointRows {
 };
 
 /// A contact's three friction rows: t1 and t2 at the patch's centre of pressure, the twist
-/// about n.
+/// about n (whose angular rows are n itself, ContactRows::dir[0]).
 struct FrictionRows {
-  std::array<Vec3, 3> ang_a, ang_b;  ///< r0 × t1, r0 × t2, n of each body, m (twist: 1).
-  std::array<Vec3, 3> inv_a, inv_b;  ///< I⁻¹ times those, 1/(kg·m).
   std::array<double, 3> mass{};      ///< 1 / (d·K d) of each row, kg (twist: kg·m²).
   double radius = 0.0;               ///< Mean distance of the points from that centre, m.
+  std::array<Vec3, 2> ang_a, ang_b;  ///< r0 × t1, r0 × t2 of each body, m.
+  std::array<Vec3, 3> inv_a, inv_b;  ///< I⁻¹ times those and n, 1/(kg·m) (twist: 1/(kg·m²)).
 };
 
-/// A contact's solver data: its directions, its points' rows and its normal block in the
-/// patch's plane coordinates. K⁺ = D P Dᵀ (active_set.hpp); the normal velocities of all points
+/// A contact's solver data: its directions, its normal block in the patch's plane coordinates
+/// and its friction rows. K⁺ = D P Dᵀ (active_set.hpp); the normal velocities of all points
 /// are vn = D y with y = (normal speed at the patch origin, the two tipping rates), and an
 /// impulse Δλ = D z moves the bodies by the patch wrench u = G z, G = DᵀD: a block iteration
 /// works on 3-vectors whatever the number of points.
@@ -122,20 +122,29 @@ struct FrictionRows {
 /// (Solver::store_impulses puts them back) and its split impulses. Both lie in the order the
 /// passes meet them (colour by colour on several threads), so each thread streams through
 /// memory instead of gathering ~1 KB contacts from all over the list.
+///
+/// The rows hold what a velocity sweep reads, in the order it reads it (976 bytes), and the
+/// points' rows (PointRows), which only the split impulse, the warm start and a block that
+/// would pull read, lie in an array of their own (SolverScratch::point_rows). With the points
+/// inside (2,048 bytes a contact) each sweep of `pile` streamed twice the memory it used.
 struct ContactRows {
   std::int32_t a = -1, b = -1;  ///< Solver index of each body (−1: the floor).
   int count = 0;                ///< Points in use.
   double mu = 0.0;              ///< Coulomb μ of the pair (Contact::friction).
-  std::array<Vec3, 3> dir;  ///< n, t1, t2 (unit, world).
-  PlaneCoordinates D;       ///< (1, α, β) of each point.
-  Mat3 G = Mat3::Zero();    ///< DᵀD.
-  Mat3 PG = Mat3::Zero();   ///< P G, 1/kg.
-  Vec3 Pt = Vec3::Zero();   ///< P Dᵀ (the points' target normal speeds), N·s.
-  std::array<Vec3, 3> ca, cb;          ///< Columns of C: (r0 × n, t1 × n, t2 × n) of a and b, m.
-  std::array<Vec3, 3> inv_ca, inv_cb;  ///< I⁻¹ times those columns, 1/(kg·m).
-  FrictionRows friction;                            ///< The patch's friction rows.
-  std::array<PointRows, kMaxContactPoints> points;  ///< Normal row of each point.
+  std::array<Vec3, 3> dir;      ///< n, t1, t2 (unit, world).
+  FrictionRows friction;        ///< The patch's friction rows.
+  /// Columns of C of body a: (r0 × n, t1 × n, t2 × n), m; b's last two are the same.
+  std::array<Vec3, 3> ca;
+  Vec3 cb0 = Vec3::Zero();      ///< First column of C of body b, r0 × n, m.
+  Vec3 Pt = Vec3::Zero();       ///< P Dᵀ (the points' target normal speeds), N·s.
+  Mat3 PG = Mat3::Zero();       ///< P G, 1/kg.
+  Mat3 G = Mat3::Zero();        ///< DᵀD.
+  std::array<Vec3, 3> inv_ca, inv_cb;  ///< I⁻¹ times the columns of a and of b, 1/(kg·m).
+  PlaneCoordinates D;  ///< (1, α, β) of each point; last: a sweep reads its first `count` rows.
 };
+
+/// The rows of each point of one contact (PointRows), count of them in use.
+using ContactPointRows = std::array<PointRows, kMaxContactPoints>;
 
 /// A contact's accumulated impulses during the velocity passes (Contact's, copied in and out)
 /// and the split impulse's, which live for the step only.
@@ -162,6 +171,7 @@ struct SolverScratch {
   std::vector<SolverBody> bodies;     ///< One per solver body, in the order given.
   std::vector<std::int32_t> index;    ///< Body id → position in `bodies`, −1 when absent.
   std::vector<ContactRows> rows;      ///< Solver rows of each contact, in sweep order.
+  std::vector<ContactPointRows> point_rows;  ///< Its points' rows, in the same order.
   std::vector<ContactImpulses> impulses;  ///< Impulses of each contact, in sweep order.
   SolverBody fixed;                   ///< Stands for the floor: zero inverse mass and inertia.
   std::vector<SupportEntry> supports; ///< Shock propagation's entry of each contact.

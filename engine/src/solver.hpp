@@ -29,7 +29,7 @@ class Solver {
   Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch,
          WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
-        rows_(scratch.rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
+        rows_(scratch.rows), point_rows_(scratch.point_rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
         supports_(scratch.supports), support_start_(scratch.support_start),
         support_keys_(scratch.support_keys), order_(scratch.order), waves_(scratch.waves),
         wave_of_(scratch.wave_of), wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
@@ -147,6 +147,7 @@ class Solver {
   std::vector<std::int32_t>& index_;
   std::vector<SolverBody>& sb_;
   std::vector<ContactRows>& rows_;  // solver rows of each contact
+  std::vector<ContactPointRows>& point_rows_;  // its points' rows
   std::vector<ContactImpulses>& impulses_;  // their impulses during the velocity passes
   SolverBody& fixed_;               // the floor: absorbs impulses without moving
   std::vector<SupportEntry>& supports_;  // shock propagation's entry of each contact
