@@ -39,8 +39,16 @@ std::string machine_description() {
   }
   utsname u{};
   uname(&u);
+  // The whole project is built with one instruction set (CMakeLists.txt, TUMBLE_AVX2); the
+  // peers are Debian's packages, built for any x86-64.
+#ifdef __AVX2__
+  const std::string isa = "Tumble built with AVX2 (no FMA)";
+#else
+  const std::string isa = "Tumble built for any x86-64";
+#endif
   return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " logical cores, " +
-         u.sysname + " " + u.release + ", compiler " + __VERSION__;
+         u.sysname + " " + u.release + ", compiler " + __VERSION__ + ", " + isa +
+         ", the peers as Debian packages them";
 }
 
 /// The engine commit measured: $TUMBLE_BENCH_COMMIT if set (a build from an exported tree),
