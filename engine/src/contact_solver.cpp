@@ -117,9 +117,6 @@ void solve_friction(const ContactRows& rows, ContactImpulses& impulses, Motion& 
   const double old0 = total[0], old1 = total[1];
   double n0 = old0 - f.mass[0] * (rows.dir[1].dot(dv) + b.w.dot(f.ang_b[0]) - a.w.dot(f.ang_a[0]));
   double n1 = old1 - f.mass[1] * (rows.dir[2].dot(dv) + b.w.dot(f.ang_b[1]) - a.w.dot(f.ang_a[1]));
-  // The twist's angular rows are n on both bodies (the floor's w is zero: a.w·n is +0 there,
-  // as a.w·0 was when the floor's row was stored as zero).
-  const Vec3& n = rows.dir[0];
   const double len = std::sqrt(n0 * n0 + n1 * n1);
   if (len > limit) {
     const double scale = len > 0.0 ? limit / len : 0.0;
@@ -133,6 +130,9 @@ void solve_friction(const ContactRows& rows, ContactImpulses& impulses, Motion& 
   if (f.radius > 0.0) {
     const double old2 = total[2];
     const double twist_limit = limit * f.radius;
+    // The twist's angular rows are n on both bodies (the floor's w is zero: a.w·n is +0 there,
+    // as a.w·0 was when the floor's row was stored as zero).
+    const Vec3& n = rows.dir[0];
     total[2] = std::clamp(old2 - f.mass[2] * (b.w.dot(n) - a.w.dot(n)),
                           -twist_limit, twist_limit);
     j2 = total[2] - old2;

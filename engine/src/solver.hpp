@@ -29,7 +29,8 @@ class Solver {
   Solver(std::span<Body> bodies, std::span<const std::uint32_t> ids, SolverScratch& scratch,
          WorkerPool& pool, const Vec3& gravity_dv)
       : bodies_(bodies), ids_(ids), index_(scratch.index), sb_(scratch.bodies),
-        rows_(scratch.rows), point_rows_(scratch.point_rows), impulses_(scratch.impulses), fixed_(scratch.fixed),
+        rows_(scratch.rows), point_rows_(scratch.point_rows), impulses_(scratch.impulses),
+        fixed_(scratch.fixed),
         supports_(scratch.supports), support_start_(scratch.support_start),
         support_keys_(scratch.support_keys), order_(scratch.order), waves_(scratch.waves),
         wave_of_(scratch.wave_of), wave_start_(scratch.wave_start), wave_order_(scratch.wave_order),
