@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <functional>
 
 #include "active_set.hpp"
 #include "floor_contact.hpp"
@@ -374,6 +375,21 @@ namespace {
 // the owner's thread in contact order.
 constexpr std::size_t kShared = 24;
 
+/// Runs fn(contact, slot) over the contacts `passes` times on this thread, in contact order
+/// (the first pass backward with `first_backward` and several passes): the order a coloured
+/// sweep replays, without the colours' waits. slot(i) names contact i's rows.
+template <typename Fn, typename Slot = std::identity>
+void sweep_in_order(std::span<Contact> contacts, Fn&& fn, int passes, bool first_backward,
+                    Slot slot = {}) {
+  for (int pass = 0; pass < passes; ++pass) {
+    if (first_backward && passes > 1 && pass == 0) {
+      for (std::size_t i = contacts.size(); i-- > 0;) fn(contacts[i], slot(i));
+      continue;
+    }
+    for (std::size_t i = 0; i < contacts.size(); ++i) fn(contacts[i], slot(i));
+  }
+}
+
 /// Runs fn(contact, slot) over the contacts `passes` times (slot: the contact's rows, in sweep
 /// order), colour by colour when the solve has colours, each colour
 /// shared among the pool's threads (its contacts touch disjoint bodies). All the passes' colours
@@ -406,17 +422,8 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
   constexpr std::size_t kGrain = 8;  // contacts per chunk: 0.1–0.5 µs each
   auto backward = [&](int pass) { return first_backward && passes > 1 && pass == 0; };
   ContactColours& colours = scratch.colours;
-  if (pool.size() == 1 || colours.count() == 0) {
-    // Contact order: what the colours replay, without their cost.
-    for (int pass = 0; pass < passes; ++pass) {
-      if (backward(pass)) {
-        for (std::size_t i = contacts.size(); i-- > 0;) fn(contacts[i], i);
-        continue;
-      }
-      for (std::size_t i = 0; i < contacts.size(); ++i) fn(contacts[i], i);
-    }
-    return;
-  }
+  if (pool.size() == 1 || colours.count() == 0)
+    return sweep_in_order(contacts, fn, passes, first_backward);
   const std::size_t count = colours.count();
   const std::span<SolverBody> sb(scratch.bodies);
   // The turns go on counting from the solve's earlier passes (turn_base): zeroing them here,
@@ -451,6 +458,35 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
       false);
   for (std::size_t i = 0; i < sb.size(); ++i)
     scratch.turn_base[i] += static_cast<std::uint32_t>(passes) * colours.degree[i];
+}
+
+/// Shock propagation and the split impulse at once, each on one of two threads. Neither reads
+/// what the other writes: shock propagation moves the velocities (v, w) and the normal
+/// impulses, the split impulse only the pseudo velocities (vp, wp) and its own impulses, from
+/// rows fixed before the sweeps. Each runs in the order one thread runs it (shock propagation
+/// by height, the split impulse in contact order), so the bits are those of one thread. On
+/// two threads each shared its pass with waits per body: in `pile` the split impulse's cheap
+/// contacts gained 1.2× from the second thread, shock propagation 1.5×.
+template <typename Fn>
+void side_by_side(Solver& solver, SolverScratch& scratch, std::span<Contact> contacts,
+                  const Vec3& gravity, double dt, const SolverSettings& settings,
+                  WorkerPool& pool, Fn& split_impulse) {
+  const ContactColours& colours = scratch.colours;
+  scratch.slot_of.resize(contacts.size());
+  for (std::size_t slot = 0; slot < colours.order.size(); ++slot)
+    scratch.slot_of[colours.order[slot]] = static_cast<std::uint32_t>(slot);
+  pool.for_each(2, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t job = begin; job < end; ++job) {
+      if (job == 0) {
+        WorkerPool alone(1);
+        solver.shock_propagation(contacts, gravity, dt, alone);
+        continue;
+      }
+      sweep_in_order(contacts, split_impulse, settings.position_iterations,
+                     settings.first_sweep_backward,
+                     [&](std::size_t i) { return std::size_t{scratch.slot_of[i]}; });
+    }
+  });
 }
 
 /// True when some point of contact c penetrates deeper than `slop` (m).
@@ -525,15 +561,21 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
       solver.store_impulses(contacts[contact_at(slot)], slot);
   });
   clock.lap(SolvePass::velocity);
-  if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt, pool);
-  clock.lap(SolvePass::shock_propagation);
   // The split impulse starts from zero pseudo velocities and only pushes: while no point is
   // deeper than the slop every target is ≤ 0 and every sweep would leave all of them zero (a
   // resting stack: `pyramid` spent 6 % of its instructions proving that).
-  if (deep.load(std::memory_order_relaxed))
-    sweep(scratch, contacts, pool,
-          [&](Contact&, std::size_t slot) { solver.solve_position(slot); },
-          settings.position_iterations, settings.first_sweep_backward);
+  const bool split = deep.load(std::memory_order_relaxed) && settings.position_iterations > 0;
+  auto split_impulse = [&](Contact&, std::size_t slot) { solver.solve_position(slot); };
+  if (settings.shock_propagation && split && pool.size() == 2 && coloured) {
+    side_by_side(solver, scratch, contacts, gravity, dt, settings, pool, split_impulse);
+    clock.lap(SolvePass::shock_propagation);  // both passes, side by side
+  } else {
+    if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt, pool);
+    clock.lap(SolvePass::shock_propagation);
+    if (split)
+      sweep(scratch, contacts, pool, split_impulse, settings.position_iterations,
+            settings.first_sweep_backward);
+  }
   clock.lap(SolvePass::split_impulse);
   pool.for_each(solver_bodies.size(), kBodyGrain,
                 [&](std::size_t begin, std::size_t end) { solver.finish(begin, end); });

@@ -184,6 +184,7 @@ struct SolverScratch {
   std::vector<std::uint32_t> upper_turn;  ///< Each solve's turn at the body it holds up.
   std::vector<std::uint32_t> group_start;  ///< Its solves: each body's supports in `order`.
   std::vector<std::int32_t> colour_a, colour_b;  ///< Solver index of each contact's bodies.
+  std::vector<std::uint32_t> slot_of;  ///< Each contact's rows slot (the inverse of colour order).
   /// Each solver body's turns taken so far in this solve (SolverBody::turn is zeroed once, in
   /// parallel, when the solve starts): a sweep or shock propagation waits for turns counted
   /// from there.
