@@ -460,33 +460,34 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
     scratch.turn_base[i] += static_cast<std::uint32_t>(passes) * colours.degree[i];
 }
 
-/// Shock propagation and the split impulse at once, each on one of two threads. Neither reads
-/// what the other writes: shock propagation moves the velocities (v, w) and the normal
-/// impulses, the split impulse only the pseudo velocities (vp, wp) and its own impulses, from
-/// rows fixed before the sweeps. Each runs in the order one thread runs it (shock propagation
-/// by height, the split impulse in contact order), so the bits are those of one thread. On
-/// two threads each shared its pass with waits per body: in `pile` the split impulse's cheap
-/// contacts gained 1.2× from the second thread, shock propagation 1.5×.
+/// Shock propagation with the split impulse beside it: one thread runs the whole split
+/// impulse while the other starts shock propagation, then joins it where it has got to
+/// (Solver::BesideJob). Neither pass reads what the other writes: shock propagation moves the
+/// velocities (v, w) and the normal impulses, the split impulse only the pseudo velocities
+/// (vp, wp) and its own impulses, from rows fixed before the sweeps. The split impulse runs in
+/// contact order, as on one thread, and shock propagation's solves wait for their bodies'
+/// turns as before, so the bits are one thread's. Why: shared between two threads with a
+/// wait per body, the split impulse's cheap contacts gained only 1.2× from the second thread
+/// (`pile`: 159 → 126 µs a step), shock propagation 1.5× (263 → 171). Side by side the two
+/// take 258–266 µs instead of 297–301 (the split impulse itself ~200 µs beside shock
+/// propagation, which leaves its thread little of shock propagation to join). Two threads
+/// only: on many, the split impulse on one thread could outlast shock propagation.
 template <typename Fn>
-void side_by_side(Solver& solver, SolverScratch& scratch, std::span<Contact> contacts,
-                  const Vec3& gravity, double dt, const SolverSettings& settings,
-                  WorkerPool& pool, Fn& split_impulse) {
+void shock_beside_split(Solver& solver, SolverScratch& scratch, std::span<Contact> contacts,
+                        const Vec3& gravity, double dt, const SolverSettings& settings,
+                        WorkerPool& pool, Fn& split_impulse) {
   const ContactColours& colours = scratch.colours;
   scratch.slot_of.resize(contacts.size());
   for (std::size_t slot = 0; slot < colours.order.size(); ++slot)
     scratch.slot_of[colours.order[slot]] = static_cast<std::uint32_t>(slot);
-  pool.for_each(2, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t job = begin; job < end; ++job) {
-      if (job == 0) {
-        WorkerPool alone(1);
-        solver.shock_propagation(contacts, gravity, dt, alone);
-        continue;
-      }
-      sweep_in_order(contacts, split_impulse, settings.position_iterations,
-                     settings.first_sweep_backward,
-                     [&](std::size_t i) { return std::size_t{scratch.slot_of[i]}; });
-    }
-  });
+  auto split = [&] {
+    sweep_in_order(contacts, split_impulse, settings.position_iterations,
+                   settings.first_sweep_backward,
+                   [&](std::size_t i) { return std::size_t{scratch.slot_of[i]}; });
+  };
+  using Split = decltype(split);
+  solver.shock_propagation(contacts, gravity, dt, pool,
+                           {[](void* job) { (*static_cast<Split*>(job))(); }, &split});
 }
 
 /// True when some point of contact c penetrates deeper than `slop` (m).
@@ -567,7 +568,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   const bool split = deep.load(std::memory_order_relaxed) && settings.position_iterations > 0;
   auto split_impulse = [&](Contact&, std::size_t slot) { solver.solve_position(slot); };
   if (settings.shock_propagation && split && pool.size() == 2 && coloured) {
-    side_by_side(solver, scratch, contacts, gravity, dt, settings, pool, split_impulse);
+    shock_beside_split(solver, scratch, contacts, gravity, dt, settings, pool, split_impulse);
     clock.lap(SolvePass::shock_propagation);  // both passes, side by side
   } else {
     if (settings.shock_propagation) solver.shock_propagation(contacts, gravity, dt, pool);

@@ -33,10 +33,11 @@ namespace tumble {
 // threads, and a solve starts once its bodies' earlier solves are done (their turns): every
 // body sees the same updates in the same order as in the ordered sweep.
 void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
-                               WorkerPool& pool) {
+                               WorkerPool& pool, BesideJob beside) {
   constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
   const double g = gravity.norm();
-  if (g == 0.0) return;
+  auto alone = [&] { if (beside.run) beside.run(beside.arg); };  // no pass to share it with
+  if (g == 0.0) return alone();
   const Vec3 up = -gravity / g;
   // A contact whose normal is nearly horizontal supports nothing and is left to the
   // iterations, as is one that would hold the floor up (gravity pointing away from it): the
@@ -93,9 +94,9 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     push_up_body(contacts, {order.data() + group_start_[gi], order.data() + group_start_[gi + 1]},
                  up, dt);
   };
-  if (pool.size() == 1) {  // the height order itself: what the waves replay
+  if (pool.size() == 1 || groups == 0) {  // the height order itself: what the waves replay
     for (std::size_t gi = 0; gi < groups; ++gi) solve_group(gi);
-    return;
+    return alone();
   }
   // Each solve's wave, and its turn at each body it touches (the body it holds up, and those
   // under it): how many solves before it in height order touch that body.
@@ -136,7 +137,9 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   // solver's sweeps run (contact_solver.cpp): a solve waits only for its own bodies' earlier
   // solves. A barrier per wave held both threads for the slowest chunk of each of `pile`'s
   // waves.
-  // The turns count on from the solve's sweeps (turn_base_), as theirs do.
+  // The turns count on from the solve's sweeps (turn_base_), as theirs do. The job beside, if
+  // any, is phase 0, a single chunk: the thread that takes it meets the waves once it is done
+  // and takes the chunks left, each waiting for its bodies' turns like any other.
   auto solve_in_turn = [&](std::size_t gi) {
     const std::span<const SupportEntry> group(order.data() + group_start_[gi],
                                               order.data() + group_start_[gi + 1]);
@@ -150,10 +153,15 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     for (const SupportEntry& e : group)
       if (e.lower >= 0) pass_turn(sb_[e.lower].turn);
   };
+  const std::size_t first = beside.run ? 1 : 0;  // phases before the first wave's
   pool.for_each_phase(
-      last, 4, [&](std::size_t p) { return wave_start_[p + 2] - wave_start_[p + 1]; },
+      first + last, 4,
+      [&](std::size_t p) {
+        return p < first ? 1 : wave_start_[p - first + 2] - wave_start_[p - first + 1];
+      },
       [&](std::size_t p, std::size_t from, std::size_t to) {
-        const std::size_t begin = wave_start_[p + 1];
+        if (p < first) return beside.run(beside.arg);
+        const std::size_t begin = wave_start_[p - first + 1];
         for (std::size_t k = begin + from; k < begin + to; ++k) solve_in_turn(wave_order_[k]);
       },
       false);

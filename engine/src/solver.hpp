@@ -12,6 +12,13 @@
 
 namespace tumble {
 
+/// A job that reads and writes nothing shock propagation does, to run on one thread while
+/// the others start shock propagation (Solver::shock_propagation): run(arg), once.
+struct BesideJob {
+  void (*run)(void*) = nullptr;  ///< Null: no job.
+  void* arg = nullptr;           ///< What run is called with.
+};
+
 /// A body's velocities during one contact's sweep (m/s, rad/s).
 struct Motion {
   Vec3 v;
@@ -79,9 +86,11 @@ class Solver {
   /// False when no point of rows slot `slot` approaches faster than `threshold` (m/s) by
   /// more than round-off: the collision pass has nothing to do.
   bool may_be_fast(std::size_t slot, double threshold);
-  /// The ground-up pass over the contacts after the iterations (shock_propagation.cpp).
+  /// The ground-up pass over the contacts after the iterations (shock_propagation.cpp), and
+  /// `beside` (if any) once, on whichever thread takes it first; that thread then joins the
+  /// pass where the others have got to.
   void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
-                         WorkerPool& pool);
+                         WorkerPool& pool, BesideJob beside = {});
   /// Shock propagation of one support contact: its lower body held fixed.
   void push_up(Contact& c, const Vec3& up, double dt);
   /// Shock propagation of one body on all its supports (`group` of contacts) at once.
