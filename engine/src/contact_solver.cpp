@@ -460,9 +460,10 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
     scratch.turn_base[i] += static_cast<std::uint32_t>(passes) * colours.degree[i];
 }
 
-/// Shock propagation with the split impulse beside it: one thread runs the whole split
-/// impulse while the other starts shock propagation, then joins it where it has got to
-/// (Solver::BesideJob). Neither pass reads what the other writes: shock propagation moves the
+/// Shock propagation with the split impulse beside it: once shock propagation has found its
+/// order and waves, one thread runs the whole split impulse while the other starts the waves,
+/// and the first joins the waves where they have got to once it is done (BesideJob,
+/// solver.hpp). Neither pass reads what the other writes: shock propagation moves the
 /// velocities (v, w) and the normal impulses, the split impulse only the pseudo velocities
 /// (vp, wp) and its own impulses, from rows fixed before the sweeps. The split impulse runs in
 /// contact order, as on one thread, and shock propagation's solves wait for their bodies'
