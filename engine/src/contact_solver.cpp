@@ -375,6 +375,11 @@ namespace {
 // the owner's thread in contact order.
 constexpr std::size_t kShared = 24;
 
+/// Whether pass `pass` of `passes` runs backward: the first of several with `first_backward`.
+bool runs_backward(bool first_backward, int passes, int pass) {
+  return first_backward && passes > 1 && pass == 0;
+}
+
 /// Runs fn(contact, slot) over the contacts `passes` times on this thread, in contact order
 /// (the first pass backward with `first_backward` and several passes): the order a coloured
 /// sweep replays, without the colours' waits. slot(i) names contact i's rows.
@@ -382,7 +387,7 @@ template <typename Fn, typename Slot = std::identity>
 void sweep_in_order(std::span<Contact> contacts, Fn&& fn, int passes, bool first_backward,
                     Slot slot = {}) {
   for (int pass = 0; pass < passes; ++pass) {
-    if (first_backward && passes > 1 && pass == 0) {
+    if (runs_backward(first_backward, passes, pass)) {
       for (std::size_t i = contacts.size(); i-- > 0;) fn(contacts[i], slot(i));
       continue;
     }
@@ -420,7 +425,7 @@ template <typename Fn>
 void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool, Fn&& fn,
            int passes = 1, bool first_backward = false) {
   constexpr std::size_t kGrain = 8;  // contacts per chunk: 0.1–0.5 µs each
-  auto backward = [&](int pass) { return first_backward && passes > 1 && pass == 0; };
+  auto backward = [&](int pass) { return runs_backward(first_backward, passes, pass); };
   ContactColours& colours = scratch.colours;
   if (pool.size() == 1 || colours.count() == 0)
     return sweep_in_order(contacts, fn, passes, first_backward);
