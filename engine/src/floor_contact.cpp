@@ -213,13 +213,16 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   if (set.count == 0) return 0;
   const BodyState s0 = s;
   const Kinematics k0 = kinematics_of(s, c);
+  // A vertex that sticks takes its impulse from the state before the exchange, whatever the
+  // normal solve would have applied: that solve is needed only when it slides.
+  if (mu > 0.0 && set.count == 1 &&
+      stick_on_one_vertex(s0, k0, set.r[0], target[0], mu, s, patch))
+    return 1;
   Kinematics k = k0;
   const NormalSystem normal_sys = normal_system(k0, set);
   ActiveSetCache system(normal_sys);
   Impulses normal = solve_normal(s, k, set, system, target);
   if (mu <= 0.0) return set.count;
-  if (set.count == 1 && stick_on_one_vertex(s0, k0, set.r[0], target[0], mu, s, patch))
-    return 1;
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
   double twist = 0.0;  // torsional impulse about the normal, N·m·s
   const Vec3 up = Vec3::UnitY();

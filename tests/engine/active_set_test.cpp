@@ -1,6 +1,7 @@
 // The active-set solve of simultaneous normal impulses (active_set.hpp): rank decisions that
 // do not depend on units, and bounded impulses for points that lie almost on one line.
 #include <algorithm>
+#include <random>
 
 #include <Eigen/SVD>
 
@@ -104,6 +105,39 @@ TEST(ActiveSet, PointsOnOneLineAndSinglePointsGetThePseudoInverse) {
         {base, base}};                                                         // one, twice
     for (std::size_t c = 0; c < cases.size(); ++c)
       EXPECT_LT(pseudo_inverse_error(cases[c], normal), 1e-12) << "case " << c << ", " << size;
+  }
+}
+
+// A single point is solved without the loop (solve_active_set's first branch): its impulse is
+// the one the loop's single solve gives through the rank-one pseudo-inverse factor, bit for bit,
+// for any body, lever and approach, and zero where the point does not approach its target.
+TEST(ActiveSet, OnePointGetsTheGeneralSolvesImpulseToTheBit) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3 normal = Vec3(u(rng), u(rng), u(rng)).normalized();
+    Vec3 t1, t2;
+    tangents(normal, t1, t2);
+    const Mat3 A = Mat3::Random() + 2.0 * Mat3::Identity();
+    ContactSide side;
+    side.inv_mass = 0.1 + std::abs(u(rng));
+    side.inv_inertia = A * A.transpose();  // symmetric positive definite
+    side.origin_offset = 0.7 * Vec3(u(rng), u(rng), u(rng));
+    const Vec3 offset = Vec3::Zero();  // one point is its own origin
+    const NormalSystem sys = make_normal_system(normal, t1, t2, &offset, 1, nullptr, &side);
+    ActiveSetCache cache(sys);
+    PointVector vn(1), target(1);
+    vn(0) = 3.0 * u(rng);
+    target(0) = trial % 3 == 0 ? 0.0 : 2.0 * u(rng);
+    const double got = solve_active_set(cache, vn, target)(0);
+    // The loop's one solve: y = D_aᵀ (target − vn), z = P y, j = d · z.
+    double want = 0.0;
+    if (vn(0) < target(0) - 1e-15) {
+      Vec3 y = Vec3::Zero();
+      add_row(y, target(0) - vn(0), sys.D, 0);
+      want = row_dot(sys.D, 0, pseudo_inverse_factor(sys.D, sys.S) * y);
+    }
+    ASSERT_EQ(got, want) << "trial " << trial;
   }
 }
 
