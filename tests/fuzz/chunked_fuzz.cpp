@@ -71,10 +71,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   RequestParser parser;
   limit_parser(parser);
-  parser.eager(true);
+  parser.eager(false);  // the header first, as the session reads it (async_read_header)
   boost::beast::flat_buffer buffer(kReadBufferLimit);
   std::size_t fed = 0;
   boost::beast::error_code ec;
+  bool framing_checked = false;
   while (!parser.is_done()) {
     if (fed == input.size()) {
       parser.put_eof(ec);
@@ -89,6 +90,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     fed += n;
     const std::size_t used = parser.put(buffer.data(), ec);
     buffer.consume(used);
+    // The session checks the framing once the header is read (HttpSession::on_header), then
+    // reads the body: Beast adds the chunked body's trailer fields to the same fields, and a
+    // trailer may repeat Host or Content-Length (as an input this target found did), which
+    // frames nothing once the body has ended.
+    if (!ec && parser.is_header_done() && !framing_checked) {
+      if (check_framing(parser.get())) __builtin_trap();  // The fixed header is well framed.
+      framing_checked = true;
+      parser.eager(true);  // then the body as far as the buffer goes
+      if (buffer.size() > 0) buffer.consume(parser.put(buffer.data(), ec));
+    }
     if (ec == http::error::need_more) {
       ec = {};
       continue;
@@ -96,7 +107,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (ec) return 0;
   }
   if (ec || !parser.is_done()) return 0;
-  if (check_framing(parser.get())) __builtin_trap();  // The fixed header is well framed.
   const Request req = parser.release();
   if (req.body().size() > kBodyLimit) __builtin_trap();
   int answers = 0;
