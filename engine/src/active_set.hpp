@@ -254,10 +254,10 @@ inline PointVector solve_active_set(ActiveSetCache& cache, const PointVector& vn
   // zero), so the impulse is found here, to the bit, without that factor's rank search.
   // Tumbling boxes meet the floor on one corner in most impacts: 225,000 of the 299,000
   // floor solves of 10,000 cubes landing on a frictionless floor over 2 s.
-  if (n == 1 && D(0, 1) == 0.0 && D(0, 2) == 0.0 && cache.system().S(0, 0) > 0.0) {
+  const double s00 = cache.system().S(0, 0);
+  if (n == 1 && D(0, 1) == 0.0 && D(0, 2) == 0.0 && s00 > 0.0) {
     PointVector impulse = PointVector::Zero(1);
-    if (vn(0) < target(0) - 1e-15)
-      impulse(0) = (1.0 / cache.system().S(0, 0)) * (target(0) - vn(0));
+    if (vn(0) < target(0) - 1e-15) impulse(0) = (1.0 / s00) * (target(0) - vn(0));
     return impulse;
   }
   std::array<bool, kMaxActiveSetPoints> active{};

@@ -4,8 +4,9 @@
 // set up by limit_parser through a read buffer bounded like the session's (kReadBufferLimit),
 // in pieces whose size the first input byte picks. It must never need more buffer than the
 // limit without reporting it (flat_buffer throws past its maximum: a crash here), never accept
-// a body over kBodyLimit or an extension over kChunkExtensionLimit, and a completed request
-// must pass check_framing and get exactly one answer from handle_api, errors as JSON.
+// a body over kBodyLimit or an extension over kChunkExtensionLimit; the header, once read,
+// must pass check_framing (as the session checks it, before the body and its trailers), and a
+// completed request must get exactly one answer from handle_api, errors as JSON.
 //
 // Boost assertions go to the handler below (BOOST_ENABLE_ASSERT_HANDLER, set for this target
 // in CMakeLists.txt): every one traps, but for one known-wrong assertion in Beast 1.81 that
