@@ -130,6 +130,8 @@ void HttpSession::on_header(beast::error_code ec, std::size_t) {
   const auto& header = parser_->get();
   if (const std::optional<FramingRefusal> r = check_framing(header))
     return refuse(r->status, r->message, r->field);
+  header_fields_.clear();
+  if (parser_->chunked()) header_fields_ = header_fields(header);
   if (parser_->is_done()) return on_read({}, 0);
   if (!expects_continue(header)) return do_read_body();
   static constexpr std::string_view kContinue = "HTTP/1.1 100 Continue\r\n\r\n";
@@ -147,6 +149,9 @@ void HttpSession::do_read_body() {
 
 void HttpSession::on_read(beast::error_code ec, std::size_t) {
   if (ec) return on_read_error(ec);
+  if (parser_->chunked())
+    if (const std::optional<FramingRefusal> r = check_trailer(parser_->get(), header_fields_))
+      return refuse(r->status, r->message, r->field);
   try {
     handle(parser_->release());
   } catch (const std::exception& e) {  // e.g. std::bad_alloc: this connection ends, not the server.

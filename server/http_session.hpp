@@ -65,6 +65,7 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
   ConnectionCount::Slot slot_;
   std::string client_;  // The peer's address (the key of its read budget).
   std::optional<RequestParser> parser_;
+  HeaderFields header_fields_;  // the chunked request's header fields (to refuse a trailer)
   std::shared_ptr<void> response_;  // The response being written.
 };
 

@@ -75,6 +75,22 @@ std::optional<FramingRefusal> check_framing(const http::request_header<>& h) {
   return std::nullopt;
 }
 
+HeaderFields header_fields(const http::request_header<>& h) {
+  HeaderFields fields;
+  for (const auto& f : h) fields.push_back(&f);
+  std::sort(fields.begin(), fields.end());
+  return fields;
+}
+
+std::optional<FramingRefusal> check_trailer(const http::request_header<>& request,
+                                            const HeaderFields& header) {
+  for (const auto& f : request) {
+    if (std::binary_search(header.begin(), header.end(), static_cast<const void*>(&f))) continue;
+    return FramingRefusal{400, "trailer fields are not accepted", quoted_prefix(f.name_string())};
+  }
+  return std::nullopt;
+}
+
 bool expects_continue(const http::request_header<>& h) {
   return h.version() >= 11 && iequals(trim(h[http::field::expect]), "100-continue");
 }

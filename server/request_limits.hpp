@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <boost/beast/http.hpp>
 
@@ -44,6 +45,21 @@ void limit_parser(RequestParser& parser);
 /// "100-continue" (417, RFC 9110 §10.1.1). Every refusal closes the connection.
 std::optional<FramingRefusal> check_framing(
     const boost::beast::http::request_header<>& header);
+
+/// The fields of a request's header, by identity (their addresses, sorted), taken when the
+/// header is read: Beast adds a chunked body's trailer fields to the same list, and places a
+/// repeated name beside its first use, so only identity tells a trailer's field apart.
+using HeaderFields = std::vector<const void*>;
+
+/// The header fields of `header` as they are now. Linear in their count, which the header
+/// limit bounds.
+HeaderFields header_fields(const boost::beast::http::request_header<>& header);
+
+/// Refuses a request that gained trailer fields after `header` was taken (400, naming the
+/// first): the handler would read them as if sent in the header, so a trailer could add
+/// Authorization or Origin, which RFC 9110 §6.5.1 forbids in trailers, or repeat Host.
+std::optional<FramingRefusal> check_trailer(const boost::beast::http::request_header<>& request,
+                                            const HeaderFields& header);
 
 /// True when the client waits for "100 Continue" before sending its body.
 bool expects_continue(const boost::beast::http::request_header<>& header);

@@ -5,7 +5,8 @@
 // in pieces whose size the first input byte picks. It must never need more buffer than the
 // limit without reporting it (flat_buffer throws past its maximum: a crash here), never accept
 // a body over kBodyLimit or an extension over kChunkExtensionLimit; the header, once read,
-// must pass check_framing (as the session checks it, before the body and its trailers), and a
+// must pass check_framing (as the session checks it, before the body and its trailers), a
+// request with trailer fields is refused by check_trailer (as the session does), and any other
 // completed request must get exactly one answer from handle_api, errors as JSON.
 //
 // Boost assertions go to the handler below (BOOST_ENABLE_ASSERT_HANDLER, set for this target
@@ -77,6 +78,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::size_t fed = 0;
   boost::beast::error_code ec;
   bool framing_checked = false;
+  HeaderFields header = {};
   while (!parser.is_done()) {
     if (fed == input.size()) {
       parser.put_eof(ec);
@@ -98,6 +100,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (!ec && parser.is_header_done() && !framing_checked) {
       if (check_framing(parser.get())) __builtin_trap();  // The fixed header is well framed.
       framing_checked = true;
+      header = header_fields(parser.get());
       parser.eager(true);  // then the body as far as the buffer goes
       if (buffer.size() > 0) buffer.consume(parser.put(buffer.data(), ec));
     }
@@ -108,6 +111,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (ec) return 0;
   }
   if (ec || !parser.is_done()) return 0;
+  if (check_trailer(parser.get(), header)) return 0;  // The session answers 400 here.
   const Request req = parser.release();
   if (req.body().size() > kBodyLimit) __builtin_trap();
   int answers = 0;

@@ -333,6 +333,16 @@ const std::vector<Case>& cases() {
          return raw_request(p, raw);
        },
        400, ""},
+      // A trailer field reached the handler as if sent in the header (RFC 9110 §6.5.1): each
+      // hides a pause behind a trailer, so the checks after the row find it never ran.
+      {"TrailerField",
+       RAW("POST /api/pause HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n"
+           "2\r\n{}\r\n0\r\nX-Checksum: 1234\r\n\r\n"),
+       400, "X-Checksum"},
+      {"TrailerRepeatsHost",
+       RAW("POST /api/pause HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n"
+           "0\r\nHost: y\r\n\r\n"),
+       400, "Host"},
       // ---- Routes and methods ----------------------------------------------------------
       {"UnknownRoute", GET("/api/nothing"), 404, ""},
       {"UnknownRoutePost", POST("/api/explode", "{}"), 404, ""},
@@ -481,6 +491,17 @@ TEST_F(BadInputToken, EveryPostNeedsTheToken) {
   const json after = state();
   EXPECT_GT(after["time"].get<double>(), before["time"].get<double>());
   EXPECT_FALSE(after["paused"].get<bool>());
+}
+
+// The token sent as a trailer field is refused, not read as the header's Authorization.
+TEST_F(BadInputToken, ATrailerCannotAuthorize) {
+  const HttpReply r = raw_request(
+      port_, "POST /api/pause HTTP/1.1\r\nHost: x\r\nTransfer-Encoding: chunked\r\n\r\n"
+             "0\r\nAuthorization: Bearer t0ken\r\n\r\n");
+  EXPECT_EQ(r.status, 400u) << r.body;
+  EXPECT_EQ(r.json()["field"], "Authorization") << r.body;
+  std::this_thread::sleep_for(40ms);
+  EXPECT_FALSE(state()["paused"].get<bool>());
 }
 
 // Viewer cap: the next viewer gets a clear refusal, the others keep their stream.
