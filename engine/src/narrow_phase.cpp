@@ -188,84 +188,70 @@ void list_linked(StepContext& ctx) {
   s.linked.erase(std::unique(s.linked.begin(), s.linked.end()), s.linked.end());
 }
 
-/// Box–box manifolds of the broad-phase pairs (each pair on its own, shared among the pool's
-/// threads), numbered in pair order (their contacts are written by collide_floor, behind the
-/// floor's), then in pair order the sleeping islands they wake.
-void collide_pairs(StepContext& ctx) {
-  constexpr std::size_t kGrain = 16;  // pairs per chunk: 0.2–1 µs each
+/// Each awake body's velocities (ω = R I⁻¹ Rᵀ L) found once for the step, when the pairs are
+/// at least half as many as the awake bodies (returns true): a pile has ~7 pairs per body,
+/// each of which read both bodies' (4 % of `pile`'s instructions). 10,000 bodies in flight
+/// with a few pairs find them pair by pair. The same function either way: the same bits.
+bool share_velocities(StepContext& ctx) {
   StepScratch& s = ctx.scratch;
-  // Each awake body's velocities (ω = R I⁻¹ Rᵀ L) are found once for the step when the pairs
-  // are at least half as many as the awake bodies: a pile has ~7 pairs per body, each of
-  // which read both bodies' (4 % of `pile`'s instructions). 10,000 bodies in flight with a
-  // few pairs find them pair by pair. The same function either way: the same bits.
   const std::vector<std::uint32_t>& awake = ctx.broad.awake;
-  const bool shared = 2 * s.pairs.size() >= awake.size() && !s.pairs.empty();
-  if (shared) {
-    s.velocities.resize(ctx.bodies.size());
-    ctx.pool.for_each(awake.size(), 256, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t k = begin; k < end; ++k)
-        s.velocities[awake[k]] = motion_of(ctx.bodies[awake[k]]);
-    });
-  }
-  // A round after one that woke bodies keeps the earlier round's answer for each pair it
-  // already had (narrow_phase kept its pairs; its manifolds and slots are still here): no
-  // body has moved since, so a manifold found again would be the same, bit for bit. In
-  // `pile` (kept awake as `tumble-bench contact` keeps it) 43 % of the steps have a second
-  // round, which collided every pair again: 30 % of the box–box tests.
-  std::span<const BodyPair> earlier;
-  if (s.earlier_step == ctx.step_index) {
-    earlier = s.earlier_pairs;
-    std::swap(s.earlier_manifolds, s.manifolds);
-    std::swap(s.earlier_slot, s.slot);
-  }
-  // Only the manifolds with points are kept (a quarter of `pile`'s pairs).
-  s.manifolds.resize(s.pairs.size());
-  s.slot.resize(s.pairs.size());
-  s.record_from.resize(s.pairs.size());
-  s.record_slot.resize(s.pairs.size());
-  const std::span<const BodyPair> record_pairs(ctx.cache.record_pairs);
-  std::atomic<bool> any_record = false;
-  ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    // The lists are sorted: one search each, then walks.
-    PairWalk in_earlier(earlier, s.pairs[begin]), in_records(record_pairs, s.pairs[begin]);
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::int32_t record = in_records.find(s.pairs[k]);
-      const std::int32_t at = in_earlier.find(s.pairs[k]);
-      if (at >= 0) {  // the earlier round's manifold, and the record it kept, if any
-        s.slot[k] = s.earlier_slot[at] >= 0 ? 0 : -1;
-        if (s.slot[k] == 0) s.manifolds[k] = s.earlier_manifolds[at];
-        s.record_from[k] = record;
-        s.record_slot[k] = s.slot[k] == 0 && record >= 0 ? 0 : -1;
-        continue;
-      }
-      if (record >= 0 &&
-          recycled(ctx, s.pairs[k], shared, ctx.cache.records[record], s.manifolds[k])) {
-        s.slot[k] = s.record_slot[k] = s.manifolds[k].count > 0 ? 0 : -1;
-        s.record_from[k] = record;
-        continue;
-      }
-      bool recordable = false;
-      const BoxManifold m = manifold_of(ctx, s.pairs[k], shared, recordable);
-      s.slot[k] = m.count > 0 ? 0 : -1;
-      if (m.count > 0) s.manifolds[k] = m;
-      s.record_from[k] = -1;
-      s.record_slot[k] = m.count > 0 && recordable ? 0 : -1;
-    }
-    if (std::any_of(s.record_slot.begin() + begin, s.record_slot.begin() + end,
-                    [](std::int32_t r) { return r >= 0; }))
-      any_record.store(true, std::memory_order_relaxed);
+  if (2 * s.pairs.size() < awake.size() || s.pairs.empty()) return false;
+  s.velocities.resize(ctx.bodies.size());
+  ctx.pool.for_each(awake.size(), 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k)
+      s.velocities[awake[k]] = motion_of(ctx.bodies[awake[k]]);
   });
-  const std::uint32_t count = number_slots(s.slot, s.slot_counts, ctx.pool);
-  if (any_record.load(std::memory_order_relaxed)) {
-    keep_records(ctx);
-  } else {  // a falling pile records nothing: no pass over its pairs to say so
-    ctx.cache.record_pairs.clear();
-    ctx.cache.records.clear();
+  return true;
+}
+
+/// The manifolds of pairs [begin, end) into scratch (manifolds, slot, record_from,
+/// record_slot): the earlier round's answer, a recycled record, or a new test, in that order.
+/// A round after one that woke bodies keeps the earlier round's answer for each pair it
+/// already had (narrow_phase kept its pairs; its manifolds and slots are still here): no body
+/// has moved since, so a manifold found again would be the same, bit for bit. In `pile`
+/// (kept awake as `tumble-bench contact` keeps it) 43 % of the steps have a second round,
+/// which collided every pair again: 30 % of the box–box tests.
+void collide_range(const StepContext& ctx, std::span<const BodyPair> earlier, bool shared,
+                   std::size_t begin, std::size_t end) {
+  StepScratch& s = ctx.scratch;
+  // The lists are sorted: one search each, then walks.
+  PairWalk in_earlier(earlier, s.pairs[begin]),
+      in_records(ctx.cache.record_pairs, s.pairs[begin]);
+  for (std::size_t k = begin; k < end; ++k) {
+    const std::int32_t record = in_records.find(s.pairs[k]);
+    const std::int32_t at = in_earlier.find(s.pairs[k]);
+    if (at >= 0) {  // the earlier round's manifold, and the record it kept, if any
+      s.slot[k] = s.earlier_slot[at] >= 0 ? 0 : -1;
+      if (s.slot[k] == 0) s.manifolds[k] = s.earlier_manifolds[at];
+      s.record_from[k] = record;
+      s.record_slot[k] = s.slot[k] == 0 && record >= 0 ? 0 : -1;
+      continue;
+    }
+    if (record >= 0 &&
+        recycled(ctx, s.pairs[k], shared, ctx.cache.records[record], s.manifolds[k])) {
+      s.slot[k] = s.record_slot[k] = s.manifolds[k].count > 0 ? 0 : -1;
+      s.record_from[k] = record;
+      continue;
+    }
+    bool recordable = false;
+    const BoxManifold m = manifold_of(ctx, s.pairs[k], shared, recordable);
+    s.slot[k] = m.count > 0 ? 0 : -1;
+    if (m.count > 0) s.manifolds[k] = m;
+    s.record_from[k] = -1;
+    s.record_slot[k] = m.count > 0 && recordable ? 0 : -1;
   }
+}
+
+/// The links (pairs with a contact, in slot order), whether each wakes a sleeping body, and
+/// the step's count of contact points, from the numbered slots; then the sleeping islands
+/// the links reach woken, in link order.
+void link_and_wake(StepContext& ctx, std::uint32_t count) {
+  constexpr std::size_t kGrain = 64;
+  StepScratch& s = ctx.scratch;
   s.links.resize(count);
   s.wakes.resize(count);
   ctx.stats.contact_points = 0;
-  ctx.pool.for_each(s.pairs.size(), 4 * kGrain, [&](std::size_t begin, std::size_t end) {
+  ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     std::uint32_t points = 0;
     for (std::size_t k = begin; k < end; ++k) {
       if (s.slot[k] < 0) continue;
@@ -290,6 +276,41 @@ void collide_pairs(StepContext& ctx) {
       ++s.woken;
     }
   }
+}
+
+/// Box–box manifolds of the broad-phase pairs (each pair on its own, shared among the pool's
+/// threads), numbered in pair order (their contacts are written by collide_floor, behind the
+/// floor's), then in pair order the sleeping islands they wake.
+void collide_pairs(StepContext& ctx) {
+  constexpr std::size_t kGrain = 16;  // pairs per chunk: 0.2–1 µs each
+  StepScratch& s = ctx.scratch;
+  const bool shared = share_velocities(ctx);
+  std::span<const BodyPair> earlier;
+  if (s.earlier_step == ctx.step_index) {  // a second round: the first's answers
+    earlier = s.earlier_pairs;
+    std::swap(s.earlier_manifolds, s.manifolds);
+    std::swap(s.earlier_slot, s.slot);
+  }
+  // Only the manifolds with points are kept (a quarter of `pile`'s pairs).
+  s.manifolds.resize(s.pairs.size());
+  s.slot.resize(s.pairs.size());
+  s.record_from.resize(s.pairs.size());
+  s.record_slot.resize(s.pairs.size());
+  std::atomic<bool> any_record = false;
+  ctx.pool.for_each(s.pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    collide_range(ctx, earlier, shared, begin, end);
+    if (std::any_of(s.record_slot.begin() + begin, s.record_slot.begin() + end,
+                    [](std::int32_t r) { return r >= 0; }))
+      any_record.store(true, std::memory_order_relaxed);
+  });
+  const std::uint32_t count = number_slots(s.slot, s.slot_counts, ctx.pool);
+  if (any_record.load(std::memory_order_relaxed)) {
+    keep_records(ctx);
+  } else {  // a falling pile records nothing: no pass over its pairs to say so
+    ctx.cache.record_pairs.clear();
+    ctx.cache.records.clear();
+  }
+  link_and_wake(ctx, count);
   list_linked(ctx);
 }
 
