@@ -264,17 +264,25 @@ TEST(Rest, ABoxPlacedOnTheFloorStartsAsleepOnlyWhereTheFloorHoldsIt) {
 
 // A unit cube standing on one edge (along z, through the origin) of a floor with μ = 1,
 // turned theta0 (rad) past balance.
-Scene cube_on_edge(double theta0, double dt) {
-  const double d = std::sqrt(0.5);  // centre to edge, m
+/// A box of edges (a, b, c) (m) on its edge along z through the origin, on a floor with μ = 1,
+/// e = 0, its centre θ0 (rad) past the vertical above that edge, at rest.
+Scene box_on_edge(const Vec3& size, double theta0, double dt) {
+  const double d = 0.5 * std::hypot(size.x(), size.y());  // centre to edge, m
+  const double diagonal = std::atan2(size.y(), size.x());  // of the edge-to-centre line, body
   Scene scene;
   scene.world.floor = Floor{0.0, 0.0, 1.0};
   scene.world.dt = dt;
   BodyDef b;
-  b.orientation = Quat(Eigen::AngleAxisd(0.25 * std::numbers::pi + theta0, Vec3::UnitZ()));
+  b.size = size;
+  b.orientation =
+      Quat(Eigen::AngleAxisd(0.5 * std::numbers::pi + theta0 - diagonal, Vec3::UnitZ()));
   b.position = {-d * std::sin(theta0), d * std::cos(theta0), 0.0};
   scene.bodies.push_back(b);
   return scene;
 }
+
+/// A unit cube on an edge (box_on_edge).
+Scene cube_on_edge(double theta0, double dt) { return box_on_edge(Vec3::Ones(), theta0, dt); }
 
 // On a frictionless floor the only horizontal force is gravity's horizontal part: the centre
 // moves along x on the parabola ½ g_x t² whatever the box does, here a cube tipping off an
@@ -297,40 +305,49 @@ TEST(Glide, OnAFrictionlessFloorTheCentreFollowsTheParabolaOfTiltedGravity) {
   EXPECT_NEAR(world.body(0).s.x.y(), 0.5, 1e-6) << "the cube should lie on a face";
 }
 
-// A unit cube on one edge of a floor with μ = 1, 0.05 rad past balance, tips over as a
-// pendulum about that edge: θ̈ = 1.5 g d sin θ with d = √2/2 (tumble_reference/tipping_box.hpp,
-// Boost.Odeint). A cube pivoting on a sticking edge takes the Störmer–Verlet step
+// A unit cube (and a 0.6 × 1.4 × 0.9 m box) on one edge of a floor with μ = 1, 0.05 rad past
+// balance, tips over as a pendulum about that edge: θ̈ = 1.5 g d sin θ with d = √2/2 for the
+// cube (tumble_reference/tipping_box.hpp, Boost.Odeint). A box pivoting on a sticking edge
+// takes the Störmer–Verlet step
 // (pivot_step in floor_contact.cpp): measured at 0.2, 0.5 and 0.7 rad, −0.0021, +0.0021 and
-// +0.0036 dt from the pendulum at dt 1/60, −0.0005, +0.0009 and +0.0003 dt at 1/240 (the
-// first-order step before it met each angle 0.44–0.49 dt early and fails this bound); the pivot
-// edge stays put to 1e-15 m (the first-order step let it wander 0.68 mm at 1/60). A pivot
-// that slid, a cube that fell asleep balanced, or a step that lost the torque would fall far
-// outside these bounds.
+// +0.0036 dt from the pendulum at dt 1/60, −0.0005, +0.0009 and +0.0003 dt at 1/240 for the
+// cube (the first-order step before it met each angle 0.44–0.49 dt early and fails this
+// bound); the pivot edge stays put to 1e-15 m (the first-order step let it wander 0.68 mm at
+// 1/60). A pivot that slid, a box that fell asleep balanced, or a step that lost the torque
+// would fall far outside these bounds.
 TEST(Friction, CubeTipsOverAnEdgeAsAPendulum) {
-  const double d = std::sqrt(0.5), theta0 = 0.05;
+  const double theta0 = 0.05;
   const std::vector<double> angles{0.2, 0.5, 0.7};
-  const std::vector<double> reference =
-      tumble_reference::tipping_times(1.5 * kG * d, theta0, angles);
-  for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
-    World world(cube_on_edge(theta0, dt));
-    double t_prev = 0.0, theta_prev = theta0, pivot_moved = 0.0;
-    std::size_t next = 0;
-    for (int i = 1; i <= static_cast<int>(2.0 / dt) && next < angles.size(); ++i) {
-      world.step();
-      const BodyState& s = world.body(0).s;
-      const double theta = std::atan2(s.R(1, 0), s.R(0, 0)) - 0.25 * std::numbers::pi;
-      const Vec3 pivot = s.x + s.R * Vec3(-0.5, -0.5, 0.5);  // a corner of the pivot edge
-      pivot_moved = std::max(pivot_moved, std::hypot(pivot.x(), pivot.y()));
-      for (; next < angles.size() && theta >= angles[next]; ++next) {
-        const double f = (angles[next] - theta_prev) / (theta - theta_prev);
-        const double t = t_prev + f * (i * dt - t_prev);  // the crossing, linearly interpolated
-        EXPECT_NEAR(t, reference[next], 0.02 * dt) << "dt = " << dt << ", θ = " << angles[next];
+  // A box about an edge: θ̈ = (m g d / I_a) sin θ, I_a = m (a² + b²) / 3 = (4/3) m d², so
+  // λ² = 3 g / (4 d) (1.5 g d for the unit cube, d = √2/2).
+  for (const Vec3& size : {Vec3(1.0, 1.0, 1.0), Vec3(0.6, 1.4, 0.9)}) {
+    const double d = 0.5 * std::hypot(size.x(), size.y());
+    const double diagonal = std::atan2(size.y(), size.x());
+    const std::vector<double> reference =
+        tumble_reference::tipping_times(0.75 * kG / d, theta0, angles);
+    for (const double dt : {1.0 / 60.0, 1.0 / 240.0}) {
+      World world(box_on_edge(size, theta0, dt));
+      double t_prev = 0.0, theta_prev = theta0, pivot_moved = 0.0;
+      std::size_t next = 0;
+      for (int i = 1; i <= static_cast<int>(2.0 / dt) && next < angles.size(); ++i) {
+        world.step();
+        const BodyState& s = world.body(0).s;
+        const double theta =
+            std::atan2(s.R(1, 0), s.R(0, 0)) - (0.5 * std::numbers::pi - diagonal);
+        const Vec3 pivot = s.x + s.R * (-0.5 * size);  // a corner of the pivot edge
+        pivot_moved = std::max(pivot_moved, std::hypot(pivot.x(), pivot.y()));
+        for (; next < angles.size() && theta >= angles[next]; ++next) {
+          const double f = (angles[next] - theta_prev) / (theta - theta_prev);
+          const double t = t_prev + f * (i * dt - t_prev);  // the crossing, interpolated
+          EXPECT_NEAR(t, reference[next], 0.02 * dt)
+              << size.transpose() << ", dt = " << dt << ", θ = " << angles[next];
+        }
+        t_prev = i * dt;
+        theta_prev = theta;
       }
-      t_prev = i * dt;
-      theta_prev = theta;
+      EXPECT_EQ(next, angles.size()) << size.transpose() << ", dt = " << dt << ": no tip";
+      EXPECT_LT(pivot_moved, 1e-12) << size.transpose() << ", dt = " << dt;
     }
-    EXPECT_EQ(next, angles.size()) << "dt = " << dt << ": the cube did not tip over";
-    EXPECT_LT(pivot_moved, 1e-12) << "dt = " << dt;
   }
 }
 
