@@ -5,9 +5,11 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <boost/math/tools/toms748_solve.hpp>
 
 #include "active_set.hpp"
+#include "free_rotation.hpp"
 #include "integrators.hpp"
 
 namespace tumble {
@@ -356,11 +358,11 @@ bool both_still(const Vec3& v, const Vec3& w, const Vec3& r0, const Vec3& r1, do
 // hold both vertices still, so it is the exact change about the edge), hence ω̄ is the mean
 // of the start and end rates; the turn through h ω̄ about the edge is exact, and α(θ₁) =
 // a · ((x₁ − p) × m g) / I_a, the pivot's vertices giving no torque about their own edge and
-// I_a = aᵀ I a + m |a × (x − p)|² not changing as the body turns about a. Taken only when the
-// edge's two vertices were still at the start and are at the end (the body was already
-// pivoting and sticks): else the step below.
-void pivot_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double h,
-                const Vec3& w_start, const Vec3& w_end, const Vec3& r0, const Vec3& r1) {
+// I_a = aᵀ I a + m |a × (x − p)|² not changing as the body turns about a. The momenta are
+// those of the turn. r0, r1: the edge's vertices from the centre (world, m); w_start, w_end:
+// the angular velocities before and after the solve (rad/s).
+void edge_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double h,
+               const Vec3& w_start, const Vec3& w_end, const Vec3& r0, const Vec3& r1) {
   const Vec3 axis = (r1 - r0).normalized();
   const double w_mid = 0.5 * (axis.dot(w_start) + axis.dot(w_end));
   const Mat3 turn = rotation_from_vector((h * w_mid) * axis);
@@ -378,13 +380,99 @@ void pivot_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, doubl
   s.L = s.R * c.inertia.cwiseProduct(s.R.transpose() * w);
 }
 
+/// The principal axes (columns, body frame, a proper rotation) and moments (kg·m²) of the
+/// inertia about a point `arm` (body frame, m) from the centre: I + m (|d|² 1 − d dᵀ). A cube's
+/// (equal moments) are d itself and any two axes square to it, found without an eigensolver.
+void principal_axes_about(const BodyConstants& c, const Vec3& arm, Mat3& axes, Vec3& moments) {
+  const double d2 = arm.squaredNorm();
+  if (c.inertia.x() == c.inertia.y() && c.inertia.y() == c.inertia.z() && d2 > 0.0) {
+    const Vec3 along = arm / std::sqrt(d2);
+    const Vec3 across = along.unitOrthogonal();
+    axes.col(0) = along;
+    axes.col(1) = across;
+    axes.col(2) = along.cross(across);
+    moments = Vec3(c.inertia.x(), c.inertia.x() + c.mass * d2, c.inertia.x() + c.mass * d2);
+    return;
+  }
+  Mat3 inertia = c.mass * (d2 * Mat3::Identity() - arm * arm.transpose());
+  inertia.diagonal() += c.inertia;
+  Eigen::SelfAdjointEigenSolver<Mat3> principal;
+  principal.computeDirect(inertia);
+  axes = principal.eigenvectors();
+  if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
+  moments = principal.eigenvalues();
+}
+
+// A box on one corner that sticks is a heavy top about that corner, and the first-order step
+// below tipped it over about half a step early too. The heavy top's splitting (Touma &
+// Wisdom, Astron. J. 107, 1994; McLachlan & Zanna, Found. Comput. Math. 5, 2005) is second
+// order: about the pivot p the angular momentum L_p = L + (x − p) × P changes only by gravity's
+// torque (the floor's impulses act at p), so half a step's torque, then the free rotation
+// about p with L_p fixed, exactly (free_rotation_exact, in the principal axes of the inertia
+// about p, I_p = I + m (|d|² 1 − d dᵀ) with d the centre from the corner, fixed in the body),
+// then the other half at the end. The momenta are then those of the turn about p. The
+// contact solve before it only decides that the corner sticks.
+// p_start, L_start: the momenta before the solve; r0: the corner from the centre (world, m).
+void corner_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double h,
+                 const Vec3& p_start, const Vec3& L_start, const Vec3& r0) {
+  const Vec3 pivot = s.x + r0;
+  const Vec3 weight = c.mass * gravity;
+  const Vec3 arm = -r0;                      // from the pivot to the centre, world
+  const Vec3 arm_body = s.R.transpose() * arm;
+  Mat3 axes;
+  Vec3 moments;
+  principal_axes_about(c, arm_body, axes, moments);
+  Vec3 momentum = L_start + arm.cross(p_start) + (0.5 * h) * arm.cross(weight);
+  s.R = free_rotation_exact(moments, s.R * axes, momentum, h) * axes.transpose();
+  orthonormalize(s.R);
+  const Vec3 arm_end = s.R * arm_body;
+  s.x = pivot + arm_end;
+  momentum += (0.5 * h) * arm_end.cross(weight);
+  const Mat3 frame = s.R * axes;  // world ← the pivot's principal axes
+  const Vec3 w = frame * (frame.transpose() * momentum).cwiseQuotient(moments);
+  s.P = c.mass * w.cross(arm_end);
+  s.L = momentum - arm_end.cross(s.P);
+}
+
+// A pivot's vertices count as still below this speed (m/s, and as much again per m/s of the
+// rim's speed |ω| r): the solve leaves a sticking vertex ~1e-16 m/s, and the projection out
+// of the floor after a step up to ~1e-9. Over a step of 1/60 s, 1e-7 m/s is 2 nm.
+constexpr double kPivotStill = 1e-7;
+
+// A body resting on one corner or one edge that sticks, and that was pivoting about it
+// already, turns about it exactly (corner_step, edge_step: second order) instead of moving
+// with its end-of-step velocities. The solve before decided that the pivot holds: exactly its
+// corner or edge touches and none is about to (all targets 0), the patch sticks, and its
+// vertices are still at the start and at the end. Returns false, touching nothing, otherwise.
+bool turn_about_pivot(BodyState& s, const BodyConstants& c, const Vec3& gravity, double h,
+                      const ContactSet& set, const Impulses& target, const PatchFriction& patch,
+                      const Vec3& v_start, const Vec3& L_start) {
+  if (set.count > 2 || !(patch.impulse < patch.limit)) return false;
+  for (int i = 0; i < set.count; ++i)
+    if (target[i] != 0.0) return false;
+  const Mat3 inv_inertia = inverse_inertia_world(s, c);  // the solve has not turned R
+  const Vec3 w_start = inv_inertia * L_start, w_end = inv_inertia * s.L;
+  const double still = kPivotStill * (1.0 + c.bounding_radius * w_start.norm());
+  const Vec3& r0 = set.r[0];
+  const Vec3& r1 = set.r[set.count - 1];
+  if (!both_still(v_start, w_start, r0, r1, still) ||
+      !both_still(c.inv_mass * s.P, w_end, r0, r1, still))
+    return false;
+  if (set.count == 1)
+    corner_step(s, c, gravity, h, c.mass * v_start, L_start, r0);
+  else
+    edge_step(s, c, gravity, h, w_start, w_end, r0, r1);
+  return true;
+}
+
 // Resting contact over h seconds, a velocity-level step in the spirit of Guendelman, Bridson
 // & Fedkiw 2003 (§5–6): gravity first, then inelastic contact impulses (with friction), then
 // positions with the corrected velocities. Touching vertices may not approach; a vertex that
 // would reach the floor within the step may approach only by its gap (a speculative contact,
 // as in Box2D and Jolt), so a rocking box lands flat at the end of the step instead of
 // rotating through the floor and being pushed out. A flat box ends with v = 0 and x
-// unchanged: no sinking, no jitter. A box pivoting on a sticking edge takes pivot_step.
+// unchanged: no sinking, no jitter. A box pivoting on a sticking corner or edge turns about it
+// exactly instead (turn_about_pivot).
 void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
                   double h) {
   const Vec3 v_start = c.inv_mass * s.P;
@@ -394,17 +482,9 @@ void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, dou
   Impulses target;
   const ContactSet set = resting_set(s, c, floor_y, h, target);
   resolve(s, c, set, target, c.friction, &patch);
-  if (set.count == 2 && target[0] == 0.0 && target[1] == 0.0 && patch.impulse < patch.limit) {
-    // An edge that touches and sticks: one resting step in seven of a landing at μ = 1.
-    const Mat3 inv_inertia = inverse_inertia_world(s, c);  // R has not changed
-    const Vec3 w_start = inv_inertia * L_start, w_end = inv_inertia * s.L;
-    const double still = 1e-9 * (1.0 + c.bounding_radius * w_start.norm());
-    if (both_still(v_start, w_start, set.r[0], set.r[1], still) &&
-        both_still(c.inv_mass * s.P, w_end, set.r[0], set.r[1], still)) {
-      pivot_step(s, c, gravity, h, w_start, w_end, set.r[0], set.r[1]);
-      lift_out_of_floor(s, c, floor_y);
-      return;
-    }
+  if (turn_about_pivot(s, c, gravity, h, set, target, patch, v_start, L_start)) {
+    lift_out_of_floor(s, c, floor_y);
+    return;
   }
   s.x += horizontal_travel(v_start, c.inv_mass * s.P, patch, h);
   s.x.y() += h * c.inv_mass * s.P.y();
