@@ -434,9 +434,9 @@ void corner_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, doub
   s.L = momentum - arm_end.cross(s.P);
 }
 
-// A pivot's vertices count as still below this speed (m/s, and as much again per m/s of the
-// rim's speed |ω| r): the solve leaves a sticking vertex ~1e-16 m/s, and the projection out
-// of the floor after a step up to ~1e-9. Over a step of 1/60 s, 1e-7 m/s is 2 nm.
+// A pivot's vertices count as still below this speed (m/s; plus this fraction of the rim's
+// speed |ω| r): the solve leaves a sticking vertex ~1e-16 m/s, the projection out of the floor
+// after a step up to ~1e-9. Over a step of 1/60 s, 1e-7 m/s is 2 nm.
 constexpr double kPivotStill = 1e-7;
 
 // A body resting on one corner or one edge that sticks, and that was pivoting about it
