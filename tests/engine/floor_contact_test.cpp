@@ -309,7 +309,7 @@ TEST(Glide, OnAFrictionlessFloorTheCentreFollowsTheParabolaOfTiltedGravity) {
 // balance, tips over as a pendulum about that edge: θ̈ = 1.5 g d sin θ with d = √2/2 for the
 // cube (tumble_reference/tipping_box.hpp, Boost.Odeint). A box pivoting on a sticking edge
 // takes the Störmer–Verlet step
-// (pivot_step in floor_contact.cpp): measured at 0.2, 0.5 and 0.7 rad, −0.0021, +0.0021 and
+// (edge_step in pivot_turns.cpp): measured at 0.2, 0.5 and 0.7 rad, −0.0021, +0.0021 and
 // +0.0036 dt from the pendulum at dt 1/60, −0.0005, +0.0009 and +0.0003 dt at 1/240 for the
 // cube (the first-order step before it met each angle 0.44–0.49 dt early and fails this
 // bound); the pivot edge stays put to 1e-15 m (the first-order step let it wander 0.68 mm at
@@ -373,7 +373,7 @@ Scene cube_on_corner(double theta0, double dt) {
 // touches (after ~0.6 rad): the plane through the body diagonal and an edge is a mirror plane
 // of the cube, so a tilt in it stays in it, about the horizontal axis through the corner with
 // I = m/6 + m |d|² = 11 m / 12, |d| = √3/2: θ̈ = (12 √3 / 22) g sin θ. A sticking corner takes
-// the heavy top's splitting (corner_step in floor_contact.cpp): measured at 0.2, 0.4 and
+// the heavy top's splitting (corner_step in pivot_turns.cpp): measured at 0.2, 0.4 and
 // 0.55 rad, −0.0012, −0.0000 and +0.0058 dt from the pendulum at dt 1/60, −0.0001, −0.0001
 // and +0.0013 dt at 1/240, the corner still to 2.4e-14 m; the first-order step met them
 // 0.45–0.49 dt early and let the corner wander 0.95 mm.
@@ -458,7 +458,7 @@ TEST(Friction, ABoxSpinningOnACornerKeepsItsVerticalMomentumAndEnergy) {
 // frozen past balance (0.0028 rad past it, after 0.5 s, before sleep.cpp's rule for bodies
 // on an edge or a corner). It must stay awake, fall at the pendulum's time (0.5 rad within
 // 0.0023–0.0205 dt after it, the longer falls from 1e-5 rad the later; the first-order step
-// before pivot_step met it 0.44–0.46 dt early) and sleep only once it lies on a face, at rest
+// before edge_step met it 0.44–0.46 dt early) and sleep only once it lies on a face, at rest
 // to the resting contact's 1e-6 m.
 TEST(Sleep, ACubeJustPastBalanceOnAnEdgeFallsOntoAFaceAndOnlyThenSleeps) {
   const double d = std::sqrt(0.5), quarter = 0.5 * std::numbers::pi;
