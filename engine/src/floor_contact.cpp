@@ -390,7 +390,7 @@ bool turn_about_pivot(BodyState& s, const BodyConstants& c, const Vec3& gravity,
 }
 
 void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
-                  double h, double rest_speed_ms);
+                  double h, double rest_speed_ms, bool may_land = true);
 
 /// True when exactly two vertices of `set` touch (target 0) and the others are about to
 /// (targets below 0): a box on an edge whose face may land within the step.
@@ -469,7 +469,8 @@ bool land_from_edge(BodyState& s, const BodyConstants& c, const Vec3& gravity, d
   if (!(when > 0.0 && when <= h)) return false;
   edge_step(s, c, gravity, when, w0 * axis, (w0 + alpha * when) * axis, r0, r1);
   resolve_floor_impact(s, c, floor_y, c.restitution, c.friction, rest_speed_ms);
-  if (h - when > 1e-15) contact_step(s, c, gravity, floor_y, h - when, rest_speed_ms);
+  if (h - when > 1e-15)  // the rest of the step, without a second landing in it
+    contact_step(s, c, gravity, floor_y, h - when, rest_speed_ms, false);
   return true;
 }
 
@@ -481,9 +482,10 @@ bool land_from_edge(BodyState& s, const BodyConstants& c, const Vec3& gravity, d
 // rotating through the floor and being pushed out. A flat box ends with v = 0 and x
 // unchanged: no sinking, no jitter. A box pivoting on a sticking corner or edge turns about it
 // exactly instead (turn_about_pivot), and one rocking on an edge lands at its time
-// (land_from_edge). rest_speed_ms: the floor's rest speed (rest_speed), for those landings.
+// (land_from_edge; may_land false: not in this step). rest_speed_ms: the floor's rest speed
+// (rest_speed), for those landings.
 void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, double floor_y,
-                  double h, double rest_speed_ms) {
+                  double h, double rest_speed_ms, bool may_land) {
   const Vec3 v_start = c.inv_mass * s.P;
   const Vec3 L_start = s.L;
   const Vec3 P_start = s.P;
@@ -491,7 +493,7 @@ void contact_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, dou
   PatchFriction patch;
   Impulses target;
   const ContactSet set = resting_set(s, c, floor_y, h, target);
-  if (c.friction > 0.0 && lands_from_edge(set, target)) {
+  if (may_land && c.friction > 0.0 && lands_from_edge(set, target)) {
     BodyState start = s;
     start.P = P_start;
     if (land_from_edge(start, c, gravity, floor_y, h, rest_speed_ms, set, target)) {
