@@ -362,6 +362,21 @@ double settling(const Vec3& w, const BodyConstants& c, double h) {
   return h * w.squaredNorm() * c.bounding_radius;
 }
 
+/// True when the pivot r0, r1 (from the centre, world, m; r0 = r1 for a corner) of `solved`,
+/// the state after the contact solve, is still at the end (kPivotStill) and was at the start
+/// (v_start, L_start: before the solve; within `settling` too). Sets the angular velocities
+/// before and after the solve (rad/s); the solve has not turned R, so one I⁻¹ serves both.
+bool pivot_held(const BodyState& solved, const BodyConstants& c, double h, const Vec3& v_start,
+                const Vec3& L_start, const Vec3& r0, const Vec3& r1, Vec3& w_start,
+                Vec3& w_end) {
+  const Mat3 inv_inertia = inverse_inertia_world(solved, c);
+  w_start = inv_inertia * L_start;
+  w_end = inv_inertia * solved.L;
+  const double still = kPivotStill * (1.0 + c.bounding_radius * w_start.norm());
+  return both_still(v_start, w_start, r0, r1, still + settling(w_start, c, h)) &&
+         both_still(c.inv_mass * solved.P, w_end, r0, r1, still);
+}
+
 // A body resting on one corner or one edge that sticks, and that was pivoting about it
 // already, turns about it exactly (corner_step, edge_step: second order) instead of moving
 // with its end-of-step velocities. The solve before decided that the pivot holds: exactly its
@@ -374,14 +389,10 @@ bool turn_about_pivot(BodyState& s, const BodyConstants& c, const Vec3& gravity,
   if (set.count > 2 || !(patch.impulse < patch.limit)) return false;
   for (int i = 0; i < set.count; ++i)
     if (target[i] != 0.0) return false;
-  const Mat3 inv_inertia = inverse_inertia_world(s, c);  // the solve has not turned R
-  const Vec3 w_start = inv_inertia * L_start, w_end = inv_inertia * s.L;
-  const double still = kPivotStill * (1.0 + c.bounding_radius * w_start.norm());
   const Vec3& r0 = set.r[0];
   const Vec3& r1 = set.r[set.count - 1];
-  if (!both_still(v_start, w_start, r0, r1, still + settling(w_start, c, h)) ||
-      !both_still(c.inv_mass * s.P, w_end, r0, r1, still))
-    return false;
+  Vec3 w_start, w_end;
+  if (!pivot_held(s, c, h, v_start, L_start, r0, r1, w_start, w_end)) return false;
   if (set.count == 1)
     corner_step(s, c, gravity, h, c.mass * v_start, L_start, r0);
   else
@@ -440,13 +451,9 @@ bool land_from_edge(BodyState& s, const BodyConstants& c, const Vec3& gravity, d
   PatchFriction patch;
   resolve(t, c, edge, Impulses{}, c.friction, &patch);
   if (!(patch.impulse < patch.limit)) return false;
-  const Mat3 inv_inertia = inverse_inertia_world(s, c);
-  const Vec3 w_start = inv_inertia * s.L, w_end = inv_inertia * t.L;
   const Vec3 &r0 = edge.r[0], &r1 = edge.r[1];
-  const double still = kPivotStill * (1.0 + c.bounding_radius * w_start.norm());
-  if (!both_still(c.inv_mass * s.P, w_start, r0, r1, still + settling(w_start, c, h)) ||
-      !both_still(c.inv_mass * t.P, w_end, r0, r1, still))
-    return false;
+  Vec3 w_start, w_end;
+  if (!pivot_held(t, c, h, c.inv_mass * s.P, s.L, r0, r1, w_start, w_end)) return false;
   Vec3 axis = (r1 - r0).normalized();
   double w0 = axis.dot(w_start), alpha = (axis.dot(w_end) - w0) / h;
   const double turn = w0 * h + 0.5 * alpha * h * h;  // the step's turn without a landing
