@@ -1,5 +1,5 @@
 #pragma once
-/// The seven questions tumble-bench answers; each writes CSV, plots and its docs section into
+/// The eight questions tumble-bench answers; each writes CSV, plots and its docs section into
 /// Options::out. Single-threaded.
 #include "common.hpp"
 
@@ -18,6 +18,8 @@ void run_skip(const Options& o);
 void run_peers(const Options& o);
 /// Box–box contact and stacking (tower, pyramid, pile) on Tumble and the peers, interleaved.
 void run_contact(const Options& o);
+/// `pile`'s deepest overlap against CPU time per simulated second, dt 1/60 … 1/480, every engine.
+void run_pile_precision(const Options& o);
 /// Where the time of a step goes, per engine stage (tower, pyramid, pile, throughput, landing).
 void run_stages(const Options& o);
 

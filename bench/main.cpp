@@ -93,6 +93,7 @@ const std::vector<std::pair<std::string, std::function<void(const Options&)>>> k
     {"skip", run_skip},
     {"peers", run_peers},
     {"contact", run_contact},
+    {"pile-precision", run_pile_precision},
     {"stages", run_stages},
 };
 
@@ -125,7 +126,7 @@ std::optional<int> parse(int argc, char** argv, Invocation& inv) {
   std::string out, docs;
   const std::string src = TUMBLE_BENCH_SOURCE_DIR;
   po::options_description visible(
-      "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact|stages> "
+      "Usage: tumble-bench <all|work-precision|stability|throughput|skip|peers|contact|pile-precision|stages> "
       "[options]\nOptions");
   visible.add_options()("help,h", "this help")(
       "quick", po::bool_switch(&inv.o.quick), "short version of everything (< 60 s), for ctest")(

@@ -39,7 +39,8 @@ std::string verdict(double value, double goal, bool lower_is_better = true) {
 }
 
 /// The landing, the large pyramid and the stage breakdown (issue 11's list), from the
-/// values the `throughput`, `peers`, `contact` and `stages` sections recorded.
+/// values the `throughput`, `peers`, `contact`, `pile_precision` and `stages` sections
+/// recorded.
 std::string closing_note_contact(const std::map<std::string, std::string>& v) {
   std::ostringstream s;
   const std::string t = "throughput.landing.N10000.";
@@ -61,6 +62,19 @@ std::string closing_note_contact(const std::map<std::string, std::string>& v) {
     << " s; " << fmt(number(v, p + "tumble_ms")) << " ms per step awake, fastest peer "
     << text(v, p + "fastest_peer") << " at " << fmt(number(v, p + "ratio_to_fastest"))
     << "× Tumble's time.\n";
+  const std::string pp = "pile_precision.";
+  const auto within = [&](const std::string& engine) {  // "from dt = 1/480 (…)" or "at no dt"
+    const std::string dt = text(v, pp + engine + ".dt_within_bound");
+    if (dt == "none" || dt == "not measured") return std::string("at no dt measured");
+    return "from dt = " + dt + " (" + fmt(number(v, pp + engine + ".cpu_within_bound")) +
+           " CPU s per simulated s, against " + fmt(number(v, pp + engine + ".cpu_per_sim_s")) +
+           " at 1/60)";
+  };
+  s << "- **`pile` within 1 cm at every step** (`pile_precision` section): at dt = 1/60 Tumble's "
+       "deepest overlap is "
+    << fmt(100.0 * number(v, pp + "tumble.deepest_m")) << " cm (Bullet "
+    << fmt(100.0 * number(v, pp + "bullet.deepest_m")) << " cm); Tumble keeps 1 cm "
+    << within("tumble") << ", Bullet " << within("bullet") << ".\n";
   s << "- **Per-stage breakdown** (`stages` section): "
     << (text(v, "stages.available") == "yes" ? "measured"
         : text(v, "stages.available") == "no"

@@ -11,7 +11,8 @@ namespace tumble_bench {
 
 /// Section names in document order.
 inline constexpr const char* kSections[] = {"work_precision", "stability", "throughput", "skip",
-                                            "peers", "contact", "stages"};
+                                            "peers", "contact", "pile_precision",
+                                            "stages"};
 
 /// Writes `<out>/<name>.md`.
 void write_section(const Options& o, const std::string& name, const std::string& markdown);
