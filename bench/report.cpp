@@ -74,7 +74,12 @@ std::string closing_note_contact(const std::map<std::string, std::string>& v) {
        "deepest overlap is "
     << fmt(100.0 * number(v, pp + "tumble.deepest_m")) << " cm (Bullet "
     << fmt(100.0 * number(v, pp + "bullet.deepest_m")) << " cm); Tumble keeps 1 cm "
-    << within("tumble") << ", Bullet " << within("bullet") << ".\n";
+    << within("tumble") << ", Bullet " << within("bullet") << ". ";
+  const double matched = number(v, pp + "bullet.cpu_ratio_at_tumble_depth");
+  s << (std::isnan(matched) ? std::string("Bullet is deeper than Tumble's 1/60 overlap at every dt")
+                            : "At Tumble's 1/60 overlap Bullet takes " + fmt(matched) +
+                                  "× Tumble's CPU time (its curve interpolated)")
+    << ".\n";
   s << "- **Per-stage breakdown** (`stages` section): "
     << (text(v, "stages.available") == "yes" ? "measured"
         : text(v, "stages.available") == "no"

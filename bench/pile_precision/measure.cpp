@@ -70,4 +70,23 @@ Measurement measure(const Options& o) {
   return m;
 }
 
+double cpu_at_depth(const Measurement& m, const std::string& engine, double depth,
+                    bool* at_most) {
+  *at_most = false;
+  const Point* before = nullptr;  // the engine at the previous (larger) dt
+  for (const Point& p : m.points) {
+    if (p.engine != engine || !std::isfinite(p.cpu_per_sim_s)) continue;
+    if (p.deepest <= depth) {
+      if (!before) {
+        *at_most = true;
+        return p.cpu_per_sim_s;
+      }
+      const double f = std::log(before->deepest / depth) / std::log(before->deepest / p.deepest);
+      return before->cpu_per_sim_s * std::pow(p.cpu_per_sim_s / before->cpu_per_sim_s, f);
+    }
+    before = &p;
+  }
+  return NAN;
+}
+
 }  // namespace tumble_bench::pile_precision

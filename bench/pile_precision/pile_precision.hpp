@@ -38,6 +38,13 @@ struct Measurement {
 /// Runs every engine at every step size, interleaved (each dt runs every engine in turn).
 Measurement measure(const Options& o);
 
+/// An engine's CPU s per simulated second at overlap `depth` (m): log–log interpolation
+/// between the two step sizes whose deepest overlaps bracket it, first crossing from the
+/// largest dt. NaN when the engine stays deeper at every dt measured; its cost at the largest
+/// dt (an upper bound, *at_most set) when it is already within `depth` there.
+double cpu_at_depth(const Measurement& m, const std::string& engine, double depth,
+                    bool* at_most);
+
 /// Writes pile_precision.csv, the headline values and the plot; returns the SVG path.
 fs::path record(const Options& o, const Measurement& m);
 

@@ -28,7 +28,7 @@ void record_headlines(const Options& o, const Measurement& m) {
     for (const Point& p : m.points) {
       if (p.engine != engine || !p.trouble.empty()) continue;
       if (p.dt == m.dts.front()) {
-        record_value(o, k + "deepest_m", fmt(p.deepest, 4));
+        record_value(o, k + "deepest_m", fmt(p.deepest, 6));
         record_value(o, k + "cpu_per_sim_s", fmt(p.cpu_per_sim_s, 4));
       }
       if (p.deepest <= kBound && !(p.dt <= within_dt)) {
@@ -38,6 +38,11 @@ void record_headlines(const Options& o, const Measurement& m) {
     }
     record_value(o, k + "dt_within_bound", std::isfinite(within_dt) ? dt_label(within_dt) : "none");
     record_value(o, k + "cpu_within_bound", fmt(within_cpu, 4));
+    // This engine's cost at the overlap Tumble keeps at the largest dt, over Tumble's cost.
+    const Point& tumble = m.points.front();
+    bool at_most = false;
+    const double cpu = cpu_at_depth(m, engine, tumble.deepest, &at_most);
+    record_value(o, k + "cpu_ratio_at_tumble_depth", fmt(cpu / tumble.cpu_per_sim_s, 4));
   }
 }
 

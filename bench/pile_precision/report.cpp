@@ -44,6 +44,33 @@ std::string notes(const Measurement& m) {
   return items.empty() ? "" : "Not run, not valid or cut short:\n\n" + bullet_list(items);
 }
 
+/// What each peer's run costs at the overlap Tumble keeps at the largest dt.
+std::string matched(const Measurement& m) {
+  const Point& tumble = m.points.front();  // Tumble at the largest dt runs first
+  if (!std::isfinite(tumble.cpu_per_sim_s)) return "";
+  std::vector<std::string> items;
+  for (const std::string& engine : m.engines) {
+    if (engine == tumble.engine) continue;
+    bool at_most = false;
+    const double cpu = cpu_at_depth(m, engine, tumble.deepest, &at_most);
+    if (std::isnan(cpu)) {
+      const bool ran = std::any_of(m.points.begin(), m.points.end(), [&](const Point& p) {
+        return p.engine == engine && std::isfinite(p.cpu_per_sim_s);
+      });
+      if (ran) items.push_back(engine + ": deeper at every dt down to " + dt_label(m.dts.back()));
+      continue;
+    }
+    items.push_back(engine + ": " + (at_most ? "at most " : "about ") + fmt(cpu) +
+                    " CPU s per simulated s, " + fmt(cpu / tumble.cpu_per_sim_s) + "× Tumble's");
+  }
+  if (items.empty()) return "";
+  return "At Tumble's own overlap at dt = " + dt_label(tumble.dt) + " (" +
+         fmt(tumble.deepest * 100.0) + " cm, " + fmt(tumble.cpu_per_sim_s) +
+         " CPU s per simulated s), what each peer's run costs (its curve interpolated on the "
+         "log–log axes between the two step sizes that bracket that overlap):\n\n" +
+         bullet_list(items);
+}
+
 }  // namespace
 
 void report(const Options& o, const Measurement& m, const fs::path& svg) {
@@ -72,6 +99,7 @@ void report(const Options& o, const Measurement& m, const fs::path& svg) {
                          table)},
       {"csv", file_link(o, o.out / "pile_precision.csv")},
       {"notes", notes(m)},
+      {"matched", matched(m)},
   };
   write_section(o, "pile_precision", fill_template("pile_precision", f));
 }
