@@ -52,10 +52,10 @@ fs::path record(const Options& o, const Measurement& m) {
   {
     Csv out(o.out / "pile_precision.csv",
             {"engine", "dt", "steps", "cpu_s_per_sim_s", "deepest_m", "deepest_at_s",
-             "time_deeper_than_bound_s", "bound_m", "trouble"});
+             "time_deeper_than_bound_s", "bound_m", "trouble", "dt_label"});
     for (const Point& p : m.points) {
       out.row() << p.engine << p.dt << p.steps << p.cpu_per_sim_s << p.deepest << p.deepest_at
-                << p.time_over << kBound << p.trouble;
+                << p.time_over << kBound << p.trouble << dt_label(p.dt);
       print(p);
     }
   }
@@ -68,7 +68,9 @@ fs::path record(const Options& o, const Measurement& m) {
   const std::string script =
       wp::log_plot("pile_precision.csv", "CPU s per simulated second", "deepest overlap (m)", 4,
                    5, curves, 1, "pile: deepest overlap against run time, dt = 1/60 ... 1/480") +
-      ", \\\n     " + fmt(kBound) + " with lines dt 2 lc 'gray' title '1 cm'\n";
+      ", \\\n     " + fmt(kBound) + " with lines dt 2 lc 'gray' title '1 cm', \\\n" +
+      "     'pile_precision.csv' skip 1 using 4:5:(strcol(10)) with labels offset char 1.5,0.6 "
+      "font ',9' notitle\n";  // each point's dt
   return plot(o, "pile_precision", script);
 }
 
