@@ -14,7 +14,8 @@ void run_stability(const Options& o);
 void run_throughput(const Options& o);
 /// Cost of 10,000 resting + 10 falling boxes against the 10 alone.
 void run_skip(const Options& o);
-/// The same scenes on Bullet, ODE and MuJoCo, interleaved with Tumble; ratios.
+/// The same scenes on Bullet, ODE, MuJoCo (and Box3D when built beside), interleaved with
+/// Tumble; ratios.
 void run_peers(const Options& o);
 /// Box–box contact and stacking (tower, pyramid, pile) on Tumble and the peers, interleaved.
 void run_contact(const Options& o);

@@ -36,6 +36,7 @@ class TumbleAsPeer final : public PeerWorld {
 Contender peer_contender(const PeerEngine& p) {
   const std::string note = p.name == "bullet" ? "DISABLE_DEACTIVATION on every body"
                            : p.name == "ode"  ? "auto-disable off"
+                           : p.name == "box3d" ? "enableSleep off"
                                               : "no sleeping in MuJoCo 2.2: always awake";
   return {p.name,
           [make = p.make](const tumble::Scene& s, const PeerSetup& setup) {

@@ -13,6 +13,9 @@ std::vector<PeerEngine> available_peers() {
 #ifdef TUMBLE_BENCH_HAVE_MUJOCO
   peers.push_back(mujoco_peer(false));
 #endif
+#ifdef TUMBLE_BENCH_HAVE_BOX3D
+  peers.push_back(box3d_peer());
+#endif
   return peers;
 }
 

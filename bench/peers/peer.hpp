@@ -1,5 +1,5 @@
 #pragma once
-/// A small common interface over the peer engines (Bullet, ODE, MuJoCo) so every benchmark
+/// A small common interface over the peer engines (Bullet, ODE, MuJoCo; Box3D when built beside) so every benchmark
 /// writes the same scene into each of them. World frame as in Tumble: y up, floor y = 0.
 /// Not thread-safe: one thread owns a PeerWorld.
 #include <functional>
@@ -88,6 +88,9 @@ PeerEngine ode_peer();  ///< Open Dynamics Engine.
 #endif
 #ifdef TUMBLE_BENCH_HAVE_MUJOCO
 PeerEngine mujoco_peer(bool rk4);  ///< MuJoCo with Euler (default) or RK4.
+#endif
+#ifdef TUMBLE_BENCH_HAVE_BOX3D
+PeerEngine box3d_peer();  ///< Box3D, built by hand beside Tumble (TUMBLE_BOX3D_ROOT).
 #endif
 
 }  // namespace tumble_bench

@@ -1,9 +1,10 @@
 #pragma once
-/// peers: the same scenes on Bullet, ODE and MuJoCo (those found at build time), interleaved
-/// with Tumble in one run: `tumble` at many dt, `bounce` apexes, throughput at N = 1,000 and
-/// 10,000, `skip`, and the `landing` variant (unit cubes onto a floor with μ = 1, e = 0).
+/// peers: the same scenes on Bullet, ODE, MuJoCo and Box3D (those found at build time),
+/// interleaved with Tumble in one run: `tumble` at many dt, `bounce` apexes, throughput at
+/// N = 1,000 and 10,000, `skip`, and the `landing` variant (unit cubes onto a floor with μ = 1,
+/// e = 0).
 /// Split in measure (plain structs), record (CSV, headline values, plots) and report
-/// (bench/text/peers.md). The adapters themselves are peer.hpp and bullet/ode/mujoco.cpp.
+/// (bench/text/peers.md). The adapters themselves are peer.hpp and bullet/ode/mujoco/box3d.cpp.
 #include <cmath>
 #include <cstddef>
 #include <map>

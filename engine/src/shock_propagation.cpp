@@ -34,18 +34,30 @@ namespace tumble {
 // body sees the same updates in the same order as in the ordered sweep.
 void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
                                WorkerPool& pool, BesideJob beside) {
-  constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
-  const double g = gravity.norm();
   auto alone = [&] { if (beside.run) beside.run(beside.arg); };  // no pass to share it with
+  const double g = gravity.norm();
   if (g == 0.0) return alone();
   const Vec3 up = -gravity / g;
-  // A contact whose normal is nearly horizontal supports nothing and is left to the
-  // iterations, as is one that would hold the floor up (gravity pointing away from it): the
-  // floor does not move, and the body under it has no support to be pushed from.
-  // Each contact's entry (with its lower body's solver index, for the waves below) is found on
-  // the pool: on the owner's thread alone this read every ~1 KB contact, a cache miss each,
-  // while the other threads waited. With the bucket sort below, the pass's serial part in
-  // `pile` on two threads went from ~124 to ~81 µs a step (the same bits).
+  find_supports(contacts, up, pool);
+  const std::size_t groups = order_supports_by_height();
+  if (pool.size() == 1 || groups == 0) {  // the height order itself: what the waves replay
+    for (std::size_t gi = 0; gi < groups; ++gi) push_up_body(contacts, group(gi), up, dt);
+    return alone();
+  }
+  const std::uint32_t last = number_waves(groups);
+  order_groups_by_wave(groups, last);
+  push_up_in_waves(contacts, up, dt, pool, beside, last);
+}
+
+// A contact whose normal is nearly horizontal supports nothing and is left to the iterations,
+// as is one that would hold the floor up (gravity pointing away from it): the floor does not
+// move, and the body under it has no support to be pushed from. Each contact's entry (with its
+// lower body's solver index, for the waves) is found on the pool: on the owner's thread alone
+// this read every ~1 KB contact, a cache miss each, while the other threads waited. With the
+// bucket sort of order_supports_by_height, the pass's serial part in `pile` on two threads
+// went from ~124 to ~81 µs a step (the same bits).
+void Solver::find_supports(std::span<const Contact> contacts, const Vec3& up, WorkerPool& pool) {
+  constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
   std::vector<SupportEntry>& found = supports_;
   found.resize(contacts.size());
   pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
@@ -59,11 +71,15 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
                   lower == kStaticBody ? -1 : index_[lower], 0};
     }
   });
-  // By the height of the supported body (then its id), its contacts together in contact
-  // order, each body a group: the entries are put in buckets by body (a counting sort, which
-  // keeps contact order), and only the bodies are sorted, by (height, solver index; solver
-  // bodies ascend by id). Sorting the ~1,400 entries of `pile` themselves took ~70 µs a step;
-  // the ~900 bodies' keys and the buckets take ~50.
+}
+
+// By the height of the supported body (then its id), its contacts together in contact order,
+// each body a group: the entries are put in buckets by body (a counting sort, which keeps
+// contact order), and only the bodies are sorted, by (height, solver index; solver bodies
+// ascend by id). Sorting the ~1,400 entries of `pile` themselves took ~70 µs a step; the ~900
+// bodies' keys and the buckets take ~50.
+std::size_t Solver::order_supports_by_height() {
+  std::vector<SupportEntry>& found = supports_;
   std::vector<std::uint32_t>& start = support_start_;  // per solver body: its bucket
   std::vector<std::pair<double, std::uint32_t>>& keys = support_keys_;
   start.assign(sb_.size() + 1, 0);
@@ -90,33 +106,33 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   const std::size_t groups = group_start_.size();
   group_start_.push_back(at);
   std::swap(found, order);
-  auto solve_group = [&](std::size_t gi) {
-    push_up_body(contacts, {order.data() + group_start_[gi], order.data() + group_start_[gi + 1]},
-                 up, dt);
-  };
-  if (pool.size() == 1 || groups == 0) {  // the height order itself: what the waves replay
-    for (std::size_t gi = 0; gi < groups; ++gi) solve_group(gi);
-    return alone();
-  }
-  // Each solve's wave, and its turn at each body it touches (the body it holds up, and those
-  // under it): how many solves before it in height order touch that body.
+  return groups;
+}
+
+std::span<const SupportEntry> Solver::group(std::size_t gi) const {
+  return {order_.data() + group_start_[gi], order_.data() + group_start_[gi + 1]};
+}
+
+// Each solve's wave, and its turn at each body it touches (the body it holds up, and those
+// under it): how many solves before it in height order touch that body.
+std::uint32_t Solver::number_waves(std::size_t groups) {
   waves_.assign(sb_.size(), 0);
   touches_.assign(sb_.size(), 0);
   wave_of_.resize(groups);
   upper_turn_.resize(groups);
   std::uint32_t last = 0;
   for (std::size_t gi = 0; gi < groups; ++gi) {
-    const std::int32_t upper = index_[order[group_start_[gi]].upper];
+    const std::int32_t upper = index_[order_[group_start_[gi]].upper];
     std::uint32_t wave = waves_[upper];
     for (std::uint32_t k = group_start_[gi]; k < group_start_[gi + 1]; ++k) {
-      const std::int32_t lower = order[k].lower;
+      const std::int32_t lower = order_[k].lower;
       if (lower >= 0) wave = std::max(wave, waves_[lower]);
     }
     ++wave;
     waves_[upper] = wave;
     upper_turn_[gi] = touches_[upper]++;
     for (std::uint32_t k = group_start_[gi]; k < group_start_[gi + 1]; ++k) {
-      SupportEntry& e = order[k];
+      SupportEntry& e = order_[k];
       if (e.lower < 0) continue;
       waves_[e.lower] = wave;
       e.lower_turn = touches_[e.lower]++;
@@ -124,7 +140,12 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     wave_of_[gi] = wave;
     last = std::max(last, wave);
   }
-  // Counting sort of the groups by wave (stable: height order within a wave).
+  return last;
+}
+
+// A counting sort of the groups by wave (stable: height order within a wave); wave_start_[w]
+// is where wave w begins in wave_order_.
+void Solver::order_groups_by_wave(std::size_t groups, std::uint32_t last) {
   wave_start_.assign(last + 2, 0);
   for (std::uint32_t w : wave_of_) ++wave_start_[w + 1];
   for (std::size_t w = 1; w < wave_start_.size(); ++w) wave_start_[w] += wave_start_[w - 1];
@@ -133,24 +154,26 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     wave_order_[wave_start_[wave_of_[gi]]++] = static_cast<std::uint32_t>(gi);
   for (std::size_t w = wave_start_.size() - 1; w > 0; --w) wave_start_[w] = wave_start_[w - 1];
   wave_start_[0] = 0;
-  // Waves 1 … last are the phases of one job (pool.for_each_phase) without barriers, as the
-  // solver's sweeps run (contact_solver.cpp): a solve waits only for its own bodies' earlier
-  // solves. A barrier per wave held both threads for the slowest chunk of each of `pile`'s
-  // waves.
-  // The turns count on from the solve's sweeps (turn_base_), as theirs do. The job beside, if
-  // any, is phase 0, a single chunk: the thread that takes it meets the waves once it is done
-  // and takes the chunks left, each waiting for its bodies' turns like any other.
+}
+
+// Waves 1 … last are the phases of one job (pool.for_each_phase) without barriers, as the
+// solver's sweeps run (contact_solver.cpp): a solve waits only for its own bodies' earlier
+// solves. A barrier per wave held both threads for the slowest chunk of each of `pile`'s
+// waves. The turns count on from the solve's sweeps (turn_base_), as theirs do. The job
+// beside, if any, is phase 0, a single chunk: the thread that takes it meets the waves once it
+// is done and takes the chunks left, each waiting for its bodies' turns like any other.
+void Solver::push_up_in_waves(std::span<Contact> contacts, const Vec3& up, double dt,
+                              WorkerPool& pool, BesideJob beside, std::uint32_t last) {
   auto solve_in_turn = [&](std::size_t gi) {
-    const std::span<const SupportEntry> group(order.data() + group_start_[gi],
-                                              order.data() + group_start_[gi + 1]);
-    const std::int32_t u = index_[group[0].upper];
+    const std::span<const SupportEntry> supports = group(gi);
+    const std::int32_t u = index_[supports[0].upper];
     SolverBody& upper = sb_[u];
     wait_turn(upper.turn, turn_base_[u] + upper_turn_[gi]);
-    for (const SupportEntry& e : group)
+    for (const SupportEntry& e : supports)
       if (e.lower >= 0) wait_turn(sb_[e.lower].turn, turn_base_[e.lower] + e.lower_turn);
-    push_up_body(contacts, group, up, dt);
+    push_up_body(contacts, supports, up, dt);
     pass_turn(upper.turn);
-    for (const SupportEntry& e : group)
+    for (const SupportEntry& e : supports)
       if (e.lower >= 0) pass_turn(sb_[e.lower].turn);
   };
   const std::size_t first = beside.run ? 1 : 0;  // phases before the first wave's

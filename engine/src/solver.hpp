@@ -91,6 +91,21 @@ class Solver {
   /// pass where the others have got to.
   void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
                          WorkerPool& pool, BesideJob beside = {});
+  /// Shock propagation's entry of each contact into supports_ (upper kStaticBody: not a
+  /// support), on the pool.
+  void find_supports(std::span<const Contact> contacts, const Vec3& up, WorkerPool& pool);
+  /// Groups the supports by the body they hold up, bodies by height (order_, group_start_);
+  /// returns the number of groups.
+  std::size_t order_supports_by_height();
+  /// Group gi of order_: the supports of one body.
+  std::span<const SupportEntry> group(std::size_t gi) const;
+  /// Each group's wave and its turns at the bodies it touches; returns the last wave.
+  std::uint32_t number_waves(std::size_t groups);
+  /// The groups wave by wave into wave_order_, each wave's start in wave_start_.
+  void order_groups_by_wave(std::size_t groups, std::uint32_t last);
+  /// Shock propagation wave by wave on the pool, with `beside` as the first phase.
+  void push_up_in_waves(std::span<Contact> contacts, const Vec3& up, double dt,
+                        WorkerPool& pool, BesideJob beside, std::uint32_t last);
   /// Shock propagation of one support contact: its lower body held fixed.
   void push_up(Contact& c, const Vec3& up, double dt);
   /// Shock propagation of one body on all its supports (`group` of contacts) at once.
