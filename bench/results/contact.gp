@@ -10,11 +10,12 @@ set ylabel 'CPU ms per step'
 set xrange [-0.6:3.6]
 set xtics ('tower (10)' 0, 'pyramid (210)' 1, 'pile (1000)' 2, 'pyramid_large (5050)' 3)
 set key top left
-set boxwidth 0.16
+set boxwidth 0.133333
 set style fill solid 0.8
 set datafile separator ','
-plot 'contact.csv' skip 1 using (strcol(3) eq 'tumble' ? $2 + (-0.32) : 1/0):7 with boxes title 'tumble', \
-     'contact.csv' skip 1 using (strcol(3) eq 'tumble-2t' ? $2 + (-0.16) : 1/0):7 with boxes title 'tumble-2t', \
-     'contact.csv' skip 1 using (strcol(3) eq 'bullet' ? $2 + (0) : 1/0):7 with boxes title 'bullet', \
-     'contact.csv' skip 1 using (strcol(3) eq 'ode' ? $2 + (0.16) : 1/0):7 with boxes title 'ode', \
-     'contact.csv' skip 1 using (strcol(3) eq 'mujoco' ? $2 + (0.32) : 1/0):7 with boxes title 'mujoco'
+plot 'contact.csv' skip 1 using (strcol(3) eq 'tumble' ? $2 + (-0.333333) : 1/0):7 with boxes title 'tumble', \
+     'contact.csv' skip 1 using (strcol(3) eq 'tumble-2t' ? $2 + (-0.2) : 1/0):7 with boxes title 'tumble-2t', \
+     'contact.csv' skip 1 using (strcol(3) eq 'bullet' ? $2 + (-0.0666667) : 1/0):7 with boxes title 'bullet', \
+     'contact.csv' skip 1 using (strcol(3) eq 'ode' ? $2 + (0.0666667) : 1/0):7 with boxes title 'ode', \
+     'contact.csv' skip 1 using (strcol(3) eq 'mujoco' ? $2 + (0.2) : 1/0):7 with boxes title 'mujoco', \
+     'contact.csv' skip 1 using (strcol(3) eq 'box3d' ? $2 + (0.333333) : 1/0):7 with boxes title 'box3d'

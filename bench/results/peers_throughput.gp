@@ -16,4 +16,6 @@ plot 'peers_throughput.csv' skip 1 using (strcol(1) eq 'tumble' && strcol(2) eq 
      'peers_throughput.csv' skip 1 using (strcol(1) eq 'ode' && strcol(2) eq 'cube' ? $3 : 1/0):4 with linespoints lw 2 dt 2 title 'ode, cubes', \
      'peers_throughput.csv' skip 1 using (strcol(1) eq 'ode' && strcol(2) eq 'box' ? $3 : 1/0):4 with linespoints lw 2 title 'ode, boxes', \
      'peers_throughput.csv' skip 1 using (strcol(1) eq 'mujoco' && strcol(2) eq 'cube' ? $3 : 1/0):4 with linespoints lw 2 dt 2 title 'mujoco, cubes', \
-     'peers_throughput.csv' skip 1 using (strcol(1) eq 'mujoco' && strcol(2) eq 'box' ? $3 : 1/0):4 with linespoints lw 2 title 'mujoco, boxes'
+     'peers_throughput.csv' skip 1 using (strcol(1) eq 'mujoco' && strcol(2) eq 'box' ? $3 : 1/0):4 with linespoints lw 2 title 'mujoco, boxes', \
+     'peers_throughput.csv' skip 1 using (strcol(1) eq 'box3d' && strcol(2) eq 'cube' ? $3 : 1/0):4 with linespoints lw 2 dt 2 title 'box3d, cubes', \
+     'peers_throughput.csv' skip 1 using (strcol(1) eq 'box3d' && strcol(2) eq 'box' ? $3 : 1/0):4 with linespoints lw 2 title 'box3d, boxes'

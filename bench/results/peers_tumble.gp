@@ -14,4 +14,5 @@ plot 'peers_tumble.csv' skip 1 using (strcol(1) eq 'tumble' ? $3 : 1/0):(($4 > 1
      'peers_tumble.csv' skip 1 using (strcol(1) eq 'bullet' ? $3 : 1/0):(($4 > 1e-17) ? $4 : 1e-17) with linespoints lw 1.5 title 'bullet', \
      'peers_tumble.csv' skip 1 using (strcol(1) eq 'ode' ? $3 : 1/0):(($4 > 1e-17) ? $4 : 1e-17) with linespoints lw 1.5 title 'ode', \
      'peers_tumble.csv' skip 1 using (strcol(1) eq 'mujoco' ? $3 : 1/0):(($4 > 1e-17) ? $4 : 1e-17) with linespoints lw 1.5 title 'mujoco', \
+     'peers_tumble.csv' skip 1 using (strcol(1) eq 'box3d' ? $3 : 1/0):(($4 > 1e-17) ? $4 : 1e-17) with linespoints lw 1.5 title 'box3d', \
      'peers_tumble.csv' skip 1 using (strcol(1) eq 'mujoco-rk4' ? $3 : 1/0):(($4 > 1e-17) ? $4 : 1e-17) with linespoints lw 1.5 title 'mujoco-rk4'

@@ -14,6 +14,7 @@ set ylabel 'deepest overlap (m)'
 plot 'pile_precision.csv' skip 1 using (strcol(1) eq 'tumble' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'tumble', \
      'pile_precision.csv' skip 1 using (strcol(1) eq 'bullet' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'bullet', \
      'pile_precision.csv' skip 1 using (strcol(1) eq 'ode' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'ode', \
+     'pile_precision.csv' skip 1 using (strcol(1) eq 'box3d' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'box3d', \
      0.01 with lines dt 2 lc 'gray' title '1 cm', \
      'pile_precision.csv' skip 1 using 4:5:(strcol(10)) with labels offset char 1.5,0.6 font ',9' notitle
 
