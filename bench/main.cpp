@@ -27,6 +27,13 @@ using namespace tumble_bench;
 
 namespace {
 
+// Box3D is built in only by hand, beside Tumble (bench/README.md): the page says so.
+#ifdef TUMBLE_BENCH_HAVE_BOX3D
+constexpr bool kWithBox3d = true;
+#else
+constexpr bool kWithBox3d = false;
+#endif
+
 std::string machine_description() {
   std::string cpu = "unknown CPU";
   std::ifstream f("/proc/cpuinfo");
@@ -42,11 +49,6 @@ std::string machine_description() {
   // The whole project is built with one instruction set (CMakeLists.txt, TUMBLE_AVX2); the
   // peers are Debian's packages, built for any x86-64, and Box3D (when built in) its own
   // Release build (SSE2).
-#ifdef TUMBLE_BENCH_HAVE_BOX3D
-  const std::string box3d_note = " (Box3D as built beside, its Release build)";
-#else
-  const std::string box3d_note;
-#endif
 #ifdef __AVX2__
   const std::string isa = "Tumble built with AVX2 (no FMA)";
 #else
@@ -54,7 +56,8 @@ std::string machine_description() {
 #endif
   return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " logical cores, " +
          u.sysname + " " + u.release + ", compiler " + __VERSION__ + ", " + isa +
-         ", the peers as Debian packages them" + box3d_note;
+         ", the peers as Debian packages them" +
+         (kWithBox3d ? " (Box3D as built beside, its Release build)" : "");
 }
 
 /// The engine commit measured: $TUMBLE_BENCH_COMMIT if set (a build from an exported tree),
@@ -181,12 +184,7 @@ std::string page_command_line(const Invocation& inv) {
   const std::string bench = "tumble-bench " + inv.command + (inv.o.quick ? " --quick" : "") +
                             (inv.only.empty() ? "" : " --only " + inv.only);
   if (!inv.default_paths) return bench;
-#ifdef TUMBLE_BENCH_HAVE_BOX3D
-  // Box3D is built by hand beside Tumble (bench/README.md): the recipe names where.
-  const std::string box3d = " -DTUMBLE_BOX3D_ROOT=../box3d";
-#else
-  const std::string box3d;
-#endif
+  const std::string box3d = kWithBox3d ? " -DTUMBLE_BOX3D_ROOT=../box3d" : "";
   return "cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
          "-DTUMBLE_BUILD_SERVER=OFF" + box3d + " && ninja -C build/bench tumble-bench && "
          "build/bench/bench/" + bench;

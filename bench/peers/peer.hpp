@@ -1,6 +1,6 @@
 #pragma once
-/// A small common interface over the peer engines (Bullet, ODE, MuJoCo; Box3D when built beside) so every benchmark
-/// writes the same scene into each of them. World frame as in Tumble: y up, floor y = 0.
+/// A small common interface over the peer engines (Bullet, ODE, MuJoCo; Box3D when built
+/// beside) so every benchmark writes the same scene into each of them. World frame as in Tumble: y up, floor y = 0.
 /// Not thread-safe: one thread owns a PeerWorld.
 #include <functional>
 #include <memory>
