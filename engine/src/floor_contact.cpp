@@ -9,6 +9,7 @@
 #include <boost/math/tools/toms748_solve.hpp>
 
 #include "active_set.hpp"
+#include "hermite_root.hpp"
 #include "integrators.hpp"
 #include "pivot_turns.hpp"
 
@@ -19,10 +20,10 @@ constexpr int kMaxImpactsPerStep = 32;
 constexpr double kSlop = 1e-12;          // m: deeper than this below the floor is penetration.
 constexpr double kSimultaneous = 1e-9;   // m: vertices this close to the lowest hit together.
 constexpr double kContactBand = 1e-6;    // m: vertices this close to the floor are touching.
-// Of the step: the narrowest bracket tried around the guess (a body that does not turn, whose
-// guess is exact but for round-off), and how far before the secant's root the closing
-// evaluation goes (1e-15 of the step let round-off in the heights turn it down at times).
-constexpr double kGuessRoundOff = 1e-15;
+// Of the step: how far before the secant's root the closing evaluation goes (1e-15 of the step
+// let round-off in the heights turn it down at times). The narrowest bracket tried around the
+// guess is kGuessRoundOff (hermite_root.hpp): a body that does not turn, whose guess is exact
+// but for round-off.
 constexpr double kClosingOffset = 1e-14;
 constexpr int kMaxPoints = kMaxActiveSetPoints;  // a box has 8 vertices
 
@@ -590,28 +591,6 @@ void glide_step(BodyState& s, const BodyConstants& c, const Vec3& gravity, doubl
   if (lowest < floor_y) s.x.y() += floor_y - lowest;
 }
 
-/// Root in (0, 1) of the quartic q(τ) = p(τ) + k τ²(τ − 1)², p the cubic Hermite interpolant of
-/// heights y0 > 0, y1 < 0 with slopes d0, d1 (per unit τ) at τ = 0 and 1 (the quartic term keeps
-/// those four values): Newton on q, kept inside its sign bracket by bisection (Numerical
-/// Recipes' rtsafe); no trajectory evaluation. `slope` is q's there.
-double hermite_root(double y0, double d0, double y1, double d1, double k, double& slope) {
-  // q(τ) = y0 + d0 τ + c2 τ² + c3 τ³ + k τ⁴ with q(1) = y1, q'(1) = d1.
-  const double c2 = 3.0 * (y1 - y0) - 2.0 * d0 - d1 + k;
-  const double c3 = 2.0 * (y0 - y1) + d0 + d1 - 2.0 * k;
-  double lo = 0.0, hi = 1.0;
-  double t = y0 / (y0 - y1);  // the chord's root
-  for (int n = 0; n < 60; ++n) {
-    const double q = y0 + t * (d0 + t * (c2 + t * (c3 + t * k)));
-    (q > 0.0 ? lo : hi) = t;
-    slope = d0 + t * (2.0 * c2 + t * (3.0 * c3 + 4.0 * t * k));
-    double next = slope < 0.0 ? t - q / slope : 0.5 * (lo + hi);
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - t) <= kGuessRoundOff) return next;  // τ is in units of the step
-    t = next;
-  }
-  return t;
-}
-
 /// Fourth time derivative of the height of a point at offset r (world) on a body turning at ω
 /// about a fixed axis: |ω|⁴ times r's component normal to ω, its y (m/s⁴).
 double turn_fourth_derivative_y(const Vec3& w, const Vec3& r) {
@@ -655,9 +634,8 @@ ImpactGuess hermite_time_of_impact(const BodyState& s, const BodyState& end,
     // lowest vertex's y⁗ is negative: the true height lies below the cubic).
     const double y4 =
         0.5 * (turn_fourth_derivative_y(w0, r0) + turn_fourth_derivative_y(w1, r1));
-    double slope = 0.0;
-    const double root = hermite_root(y0, d0, y1, d1, y4 * h2 * h2 / 24.0, slope);
-    if (root < earliest) earliest = root, speed = std::abs(slope) / h;
+    const HermiteRoot root = hermite_root(y0, d0, y1, d1, y4 * h2 * h2 / 24.0);
+    if (root.tau < earliest) earliest = root.tau, speed = std::abs(root.slope) / h;
   }
   if (speed == 0.0) return {h, INFINITY};  // no vertex of the mask ends below the floor
   const double omega2 = w0.dot(s.L) * c.inv_inertia.maxCoeff();  // 2E / I_min ≥ |ω|²

@@ -2,9 +2,11 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "floor_contact.hpp"
+#include "hermite_root.hpp"
 #include "tumble_reference/tipping_box.hpp"
 #include "world_fixture.hpp"
 
@@ -583,6 +585,43 @@ TEST(TimeOfImpact, HermiteGuessFindsSpinningImpactsInThreeEvaluations) {
   std::cout << "[ measured ] " << impacts << " impacts, " << per_impact
             << " trajectory evaluations each; after the first impact, off the bisection by "
             << worst_x << " m, " << worst_angle << " rad, " << worst_v << " m/s\n";
+}
+
+// The guess's root finder is Newton's method kept in a bracket: a few steps a root. A vertex
+// falling through the floor within a step of 1/240 s (a parabola plus a turn of up to 8 rad/s
+// at up to 0.5 m from the centre, the root anywhere in the step): every one of 1,000 roots in
+// at most 8 steps, with q within round-off of zero there. When Newton landed on the bracket's
+// end (q exactly 0 at a step, common once it has converged) the bracket's midpoint replaced
+// it and some forty halvings led back: 16 steps a root on average, 48 at worst.
+TEST(TimeOfImpact, HermiteRootTakesAFewNewtonSteps) {
+  std::mt19937_64 rng(7);
+  auto uniform = [&rng](double a, double b) { return std::uniform_real_distribution(a, b)(rng); };
+  constexpr double h = 1.0 / 240.0;
+  int roots = 0, steps = 0, worst = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const double v = -uniform(0.5, 6.0), w = uniform(0.0, 8.0), r = uniform(0.1, 0.5);
+    const double phase = uniform(0.0, 2.0 * std::numbers::pi), tau = uniform(0.05, 0.95);
+    auto y = [&](double t) { return v * t - 0.5 * kG * t * t + r * std::sin(w * t + phase); };
+    auto dy = [&](double t) { return v - kG * t + r * w * std::cos(w * t + phase); };
+    const double y0 = y(0.0) - y(tau * h), y1 = y(h) - y(tau * h);
+    if (!(y0 > 0.0 && y1 < 0.0)) continue;
+    const double d0 = h * dy(0.0), d1 = h * dy(h);
+    const double k = -std::pow(w, 4) * r * std::pow(h, 4) / 24.0 * uniform(0.0, 1.0);
+    const HermiteRoot root = hermite_root(y0, d0, y1, d1, k);
+    ++roots;
+    steps += root.iterations;
+    worst = std::max(worst, root.iterations);
+    // q(τ) from its Hermite form: within a few ulps of the heights' scale.
+    const double t = root.tau, s = 1.0 - t;
+    const double q = y0 * (1.0 + 2.0 * t) * s * s + d0 * t * s * s + y1 * t * t * (3.0 - 2.0 * t) -
+                     d1 * t * t * s + k * t * t * s * s;
+    EXPECT_LT(std::abs(q), 1e-15 * (y0 - y1 + std::abs(d0) + std::abs(d1))) << i;
+    EXPECT_LT(root.slope, 0.0) << i;
+  }
+  ASSERT_GT(roots, 900);
+  EXPECT_LE(worst, 8);
+  std::cout << "[ measured ] " << roots << " roots, " << static_cast<double>(steps) / roots
+            << " steps each, " << worst << " at worst\n";
 }
 
 }  // namespace
