@@ -1,5 +1,7 @@
 #pragma once
-/// Bodies against the floor plane y = h: time of impact, impulses, resting contact.
+/// Bodies against the floor plane y = h: a lone body's step with its impacts at their time
+/// and its resting contact (floor_contact.cpp; the time of impact, the impulses and the
+/// vertices' geometry in floor_time_of_impact, floor_impulse and floor_geometry).
 /// Pure functions over one body; thread-safe.
 #include "integrators.hpp"
 #include "tumble/body.hpp"
