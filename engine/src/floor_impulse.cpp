@@ -59,33 +59,46 @@ struct RoundHistory {
   int count = 0;
   std::array<Eigen::Vector2d, 2> friction;
   std::array<double, 2> twist{};
+  std::array<double, 2> limit{};        // the friction cone's radius μ Σ jₙ, N·s
+  std::array<double, 2> twist_limit{};  // the twist's bound μ Σ jₙ r̄, N·m·s
 };
 
 // The rounds below converge linearly: for a box sticking on an edge each round removes about
 // 60 % of the error, so 16 rounds ended near 1e-7 relative, never at 1e-13. Aitken's Δ²
 // process (Aitken 1926) turns three iterates x₀, x₁, x₂ of such a sequence into its limit
 // x₂ + ρ/(1 − ρ) (x₂ − x₁), ρ the ratio of successive changes: the friction impulse and the
-// twist each get it once they have three iterates whose change shrinks steadily (0 < ρ < 0.9),
-// then start afresh; the result is put back inside the friction cone, and the rounds go on
-// from there, so the answer is still the rounds' own fixed point.
+// twist each get it once they have three iterates whose change shrinks steadily (|ρ| < 0.9),
+// then start afresh. A ratio below zero is a load swinging between an edge's two vertices,
+// round after round (near −0.7 for a box sliding along the edge), and a patch that slides sits
+// on its cone, whose radius μ Σ jₙ moves with the load: the result is put back inside the cone
+// of the extrapolated load, not the last round's, which would undo it. The rounds go on from
+// there, so the answer is still the rounds' own fixed point.
 void extrapolate(RoundHistory& h, Eigen::Vector2d& friction, double& twist, double limit,
                  double twist_limit) {
   if (h.count < 2) {
     h.friction[h.count] = friction;
     h.twist[h.count] = twist;
+    h.limit[h.count] = limit;
+    h.twist_limit[h.count] = twist_limit;
     ++h.count;
     return;
   }
   const Eigen::Vector2d d1 = h.friction[1] - h.friction[0], d2 = friction - h.friction[1];
   const double rho = d1.squaredNorm() > 0.0 ? d2.dot(d1) / d1.squaredNorm() : 0.0;
-  if (rho > 0.0 && rho < 0.9) {
-    friction += rho / (1.0 - rho) * d2;
-    if (friction.norm() > limit) friction *= limit / friction.norm();
+  if (rho != 0.0 && std::abs(rho) < 0.9) {
+    const double grow = rho / (1.0 - rho);
+    friction += grow * d2;
+    const double cone = std::max(limit + grow * (limit - h.limit[1]), 0.0);
+    if (friction.norm() > cone) friction *= cone / friction.norm();
   }
   const double t1 = h.twist[1] - h.twist[0], t2 = twist - h.twist[1];
   const double tau = t1 != 0.0 ? t2 / t1 : 0.0;
-  if (tau > 0.0 && tau < 0.9)
-    twist = std::clamp(twist + tau / (1.0 - tau) * t2, -twist_limit, twist_limit);
+  if (tau != 0.0 && std::abs(tau) < 0.9) {
+    const double grow = tau / (1.0 - tau);
+    const double bound =
+        std::max(twist_limit + grow * (twist_limit - h.twist_limit[1]), 0.0);
+    twist = std::clamp(twist + grow * t2, -bound, bound);
+  }
   h.count = 0;
 }
 
@@ -129,6 +142,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   Eigen::Vector2d friction = Eigen::Vector2d::Zero();
   double twist = 0.0;  // torsional impulse about the normal, N·m·s
   const Vec3 up = Vec3::UnitY();
+  const double lever = c.bounding_radius;  // m: the twist's scale in `unsettled`
   RoundHistory history;
   for (int round = 0; round < 16; ++round) {
     double total = 0.0;
@@ -153,8 +167,10 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
     // μ N times the mean lever of its load; a single point contact has none.
     double next_twist = twist - k.w.y() / k.inv_inertia(1, 1);
     next_twist = std::clamp(next_twist, -mu * total * radius, mu * total * radius);
-    const bool settled = (next - friction).norm() <= 1e-13 * (1.0 + next.norm()) &&
-                         std::abs(next_twist - twist) <= 1e-13 * (1.0 + std::abs(next_twist));
+    const double moved = (next - friction).norm();
+    const double turned = std::abs(next_twist - twist);
+    const bool settled = moved <= 1e-13 * (1.0 + next.norm()) &&
+                         turned <= 1e-13 * (1.0 + std::abs(next_twist));
     friction = next;
     twist = next_twist;
     if (!settled) extrapolate(history, friction, twist, mu * total, mu * total * radius);
@@ -164,7 +180,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
     s.L += twist * up;
     k.w += k.inv_inertia * (twist * up);
     normal = solve_normal(s, k, set, system, target);
-    if (patch) *patch = {friction.norm(), mu * total};
+    if (patch) *patch = {friction.norm(), mu * total, settled ? 0.0 : moved + turned / lever};
     if (settled) break;
   }
   return set.count;

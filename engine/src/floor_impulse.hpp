@@ -9,6 +9,9 @@ namespace tumble::floor_detail {
 struct PatchFriction {
   double impulse = 0.0;
   double limit = 0.0;
+  /// How far the exchange's last round moved the friction impulse and the twist (N·s, the
+  /// twist over the body's bounding radius): 0 when its rounds settled to round-off.
+  double unsettled = 0.0;
 };
 
 /// One normal impulse or target per touching vertex (N·s, m/s).

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "floor_contact.hpp"
+#include "floor_impulse.hpp"
 #include "hermite_root.hpp"
 #include "tumble_reference/tipping_box.hpp"
 #include "world_fixture.hpp"
@@ -585,6 +586,54 @@ TEST(TimeOfImpact, HermiteGuessFindsSpinningImpactsInThreeEvaluations) {
   std::cout << "[ measured ] " << impacts << " impacts, " << per_impact
             << " trajectory evaluations each; after the first impact, off the bisection by "
             << worst_x << " m, " << worst_angle << " rad, " << worst_v << " m/s\n";
+}
+
+// A box sliding along the edge it stands on: the friction's torque moves the load from one
+// vertex of the edge to the other, and the exchange's rounds swing it back and forth (a
+// ratio near −0.7), or pile it onto one vertex round after round (+0.8). Aitken's
+// extrapolation took only ratios in (0, 0.9) and kept the friction inside the last round's
+// cone, so a sliding patch, always at its cone, was never extrapolated: a quarter of a μ = 1
+// landing's edge exchanges ended the 16 rounds 1e-3–1e-2 of the friction impulse from their
+// fixed point. Here 300 unit cubes on one edge, sliding at 0.2–3 m/s mostly along it and
+// sinking at 0.05–0.5 m/s (harder than a landing's edges): 233 ended unsettled before, the
+// worst 9 % of its friction limit off; now 98 (207 within 1e-8 of it), the worst 3.2 % (what
+// is left wanders among three coupled unknowns: docs/engine.md).
+TEST(Friction, AnEdgeSlidingUnderASwingingLoadSettles) {
+  using namespace floor_detail;
+  std::mt19937_64 rng(11);
+  auto uniform = [&rng](double a, double b) { return std::uniform_real_distribution(a, b)(rng); };
+  int exchanges = 0, unsettled = 0, within_1e8 = 0;
+  double worst = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    BodyDef def;
+    const double yaw = uniform(0.0, 6.3), tilt = uniform(0.15, 0.65);
+    def.orientation = Quat(Eigen::AngleAxisd(yaw, Vec3::UnitY())) *
+                      Quat(Eigen::AngleAxisd(tilt, Vec3::UnitZ()));
+    const Vec3 along = def.orientation * Vec3::UnitZ();  // the edge on the floor
+    const Vec3 across = Vec3::UnitY().cross(along);
+    def.velocity = uniform(0.2, 3.0) * along + uniform(-0.3, 0.3) * across -
+                   uniform(0.05, 0.5) * Vec3::UnitY();
+    def.angular_velocity = {uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)};
+    const BodyConstants c = make_body_constants(def, 0.0, 1.0);
+    BodyState s = make_body_state(def, c);
+    s.x.y() -= lowest_vertex_y(s, c);
+    const ContactSet set = touching_vertices(s, c, kSimultaneous);
+    ASSERT_EQ(set.count, 2) << i;
+    PatchFriction patch;
+    resolve(s, c, set, Impulses{}, c.friction, &patch);
+    ++exchanges;
+    const double off = patch.unsettled / patch.limit;
+    unsettled += off > 0.0 ? 1 : 0;
+    within_1e8 += off <= 1e-8 ? 1 : 0;
+    worst = std::max(worst, off);
+  }
+  EXPECT_LE(unsettled, 100);
+  EXPECT_GE(within_1e8, 200);
+  EXPECT_LT(worst, 0.05);
+  std::cout << "[ measured ] " << exchanges << " edge exchanges sliding: " << unsettled
+            << " not settled within 16 rounds, " << within_1e8
+            << " within 1e-8 of their friction limit from their fixed point, the worst "
+            << worst << "\n";
 }
 
 // The guess's root finder is Newton's method kept in a bracket: a few steps a root. A vertex
