@@ -3,6 +3,7 @@
 /// and its resting contact (floor_contact.cpp; the time of impact, the impulses and the
 /// vertices' geometry in floor_time_of_impact, floor_impulse and floor_geometry).
 /// Pure functions over one body; thread-safe.
+#include "floor_geometry.hpp"  // lowest_vertex_y
 #include "integrators.hpp"
 #include "tumble/body.hpp"
 #include "tumble/scene.hpp"
@@ -15,11 +16,6 @@ struct FloorStepResult {
   int toi_iterations = 0;  ///< Partial-step evaluations spent locating them.
   bool touched = false;    ///< The body was in contact with the floor at some point.
 };
-
-/// Height of the lowest vertex above the plane y = 0 (metres): x_y − Σ |R_1k| h_k.
-inline double lowest_vertex_y(const BodyState& s, const BodyConstants& c) {
-  return s.x.y() - (s.R.row(1).cwiseAbs().dot(c.half_extents));
-}
 
 /// Speed below which an impact rebounds with e = 0 and contact becomes resting contact
 /// (m/s): half the speed gravity adds in one step, so a bounce shorter than about one step

@@ -10,6 +10,15 @@
 #include "active_set.hpp"
 #include "tumble/body.hpp"
 
+namespace tumble {
+
+/// Height of the lowest vertex above the plane y = 0 (metres): x_y − Σ |R_1k| h_k.
+inline double lowest_vertex_y(const BodyState& s, const BodyConstants& c) {
+  return s.x.y() - (s.R.row(1).cwiseAbs().dot(c.half_extents));
+}
+
+}  // namespace tumble
+
 namespace tumble::floor_detail {
 
 constexpr double kSlop = 1e-12;          // m: deeper than this below the floor is penetration.

@@ -2,7 +2,6 @@
 
 #include <boost/math/tools/toms748_solve.hpp>
 
-#include "floor_contact.hpp"
 #include "hermite_root.hpp"
 #include "integrators.hpp"
 
