@@ -597,8 +597,11 @@ TEST(TimeOfImpact, HermiteGuessFindsSpinningImpactsInThreeEvaluations) {
 // impulse from their fixed point. Here 300 unit cubes on one edge, sliding at 0.2–3 m/s mostly
 // along it and sinking at 0.05–0.5 m/s (harder than a landing's edges). With Aitken: 233
 // ended unsettled, 71 within 1e-8 of their friction limit from the fixed point, the worst 9 %
-// off; with Aitken for any ratio within ±0.9, 98, 207 and 3.2 %; with Anderson mixing
-// (floor_impulse.cpp), 91, 236 and 0.34 %.
+// off; with Aitken for any ratio within ±0.9, 98, 207 and 3.2 %; with Anderson mixing of the
+// friction and the twist, 91, 236 and 0.34 %; with the point where the friction acts mixed
+// too, plain rounds after 16 for an exchange still far off and the closest round's output
+// applied (floor_impulse.cpp), 69, 271 and 0.01 % (mixed for 32 rounds, 2, 293 and 5.6 %: it
+// circles a kink).
 TEST(Friction, AnEdgeSlidingUnderASwingingLoadSettles) {
   using namespace floor_detail;
   std::mt19937_64 rng(11);
@@ -628,11 +631,11 @@ TEST(Friction, AnEdgeSlidingUnderASwingingLoadSettles) {
     within_1e8 += off <= 1e-8 ? 1 : 0;
     worst = std::max(worst, off);
   }
-  EXPECT_LE(unsettled, 95);
-  EXPECT_GE(within_1e8, 230);
-  EXPECT_LT(worst, 0.005);
+  EXPECT_LE(unsettled, 75);
+  EXPECT_GE(within_1e8, 265);
+  EXPECT_LT(worst, 1e-3);
   std::cout << "[ measured ] " << exchanges << " edge exchanges sliding: " << unsettled
-            << " not settled within 16 rounds, " << within_1e8
+            << " not settled, " << within_1e8
             << " within 1e-8 of their friction limit from their fixed point, the worst "
             << worst << "\n";
 }
