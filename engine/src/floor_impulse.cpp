@@ -215,8 +215,11 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
       limit = closest.limit;
     } else {
       RoundMixer::Vector x, g;
-      x << friction, twist / lever, applied_at;
-      g << next, next_twist / lever, centroid;
+      // Entry by entry: a 2-vector streamed into the 6-vector sent GCC's bounds check down an
+      // AVX path that cannot run (-Warray-bounds).
+      x << friction.x(), friction.y(), twist / lever, applied_at.x(), applied_at.y(),
+          applied_at.z();
+      g << next.x(), next.y(), next_twist / lever, centroid.x(), centroid.y(), centroid.z();
       const RoundMixer::Vector mixed = round < kMixedRounds ? mixer.next(x, g) : g;
       friction = mixed.head<2>();
       twist = lever * mixed(2);
