@@ -75,8 +75,7 @@ bool stick_on_one_vertex(const BodyState& s0, const Kinematics& k0, const Vec3& 
 // restarts the history; after kMixedRounds the rounds go on plain (for an exchange still far
 // from its fixed point), as mixing can circle a kink where plain rounds creep in; and the last
 // round applies the output of the round that came closest to its fixed point, so what is left
-// in the patch is always inside its cone.
-// The answer is still the rounds' own fixed point.
+// in the patch is always inside its cone. The answer is still the rounds' own fixed point.
 class RoundMixer {
  public:
   /// The unknowns (F_x, F_z, τ / r, c), N·s and m.
