@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 
+#include "friction_rounds.hpp"
+
 namespace tumble::floor_detail {
 namespace {
 
@@ -16,22 +18,6 @@ NormalSystem normal_system(const Kinematics& k, const ContactSet& set) {
   const ContactSide body{k.inv_mass, k.inv_inertia, origin};
   return make_normal_system(Vec3::UnitY(), Vec3::UnitX(), Vec3::UnitZ(), offsets.data(),
                             set.count, nullptr, &body);
-}
-
-/// Applies the active-set normal impulses (active_set.hpp) and returns them per contact.
-Impulses solve_normal(BodyState& s, Kinematics& k, const ContactSet& set, ActiveSetCache& system,
-                      const Impulses& target) {
-  const int n = set.count;
-  PointVector vn(n), goal(n);
-  for (int i = 0; i < n; ++i) vn(i) = k.point_velocity(set.r[i]).y(), goal(i) = target[i];
-  const PointVector impulse = solve_active_set(system, vn, goal);
-  Impulses applied{};
-  for (int i = 0; i < n; ++i) {
-    if (impulse(i) <= 0.0) continue;
-    k.apply(s, set.r[i], impulse(i) * Vec3::UnitY());
-    applied[i] = impulse(i);
-  }
-  return applied;
 }
 
 // A body on one vertex that sticks: the impulse j that leaves the vertex with the normal
@@ -54,64 +40,6 @@ bool stick_on_one_vertex(const BodyState& s0, const Kinematics& k0, const Vec3& 
   return true;
 }
 
-// The rounds below are a fixed-point iteration x = G(x) on x = (F_x, F_z, τ / r, c): the
-// patch's friction impulse, its twist (over the body's bounding radius r, to share units) and
-// the point c where F is applied, the centroid of the normal impulses it was found at. Plain,
-// they converge linearly: a box sticking on an edge loses about 60 % of its error a round; one
-// sliding along the edge sits on its cone μ Σ jₙ while the load swings from one vertex to the
-// other and back (a ratio near −0.7) or piles onto one of them (+0.8). Aitken's Δ² on each
-// unknown alone (the rule until 2026-11-28) took only ratios in (0, 0.9) and left a quarter of
-// a μ = 1 landing's edge exchanges 1e-3–1e-2 of the friction impulse from the fixed point
-// after 16 rounds.
-//
-// Anderson mixing of depth 2 (Anderson 1965; Walker & Ni, SIAM J. Numer. Anal. 49, 2011)
-// takes as the next input the combination of the last three outputs g whose residuals
-// f = G(x) − x cancel best in least squares, a 2×2 system here: it solves a linear map of two
-// modes exactly, whatever their signs. It needs c among the unknowns: mixed on (F, τ / r)
-// alone, the next round applied the mixed F at the new centroid, a point the mixing never
-// saw, so the map it extrapolated changed under it, and 30 % of sliding-edge exchanges never
-// settled. Three guards, as the method needs on a map with kinks (the normal solve's active
-// set, the cone, a vertex whose load goes to zero): a residual that grows more than twofold
-// restarts the history; after kMixedRounds the rounds go on plain (for an exchange still far
-// from its fixed point), as mixing can circle a kink where plain rounds creep in; and the last
-// round applies the output of the round that came closest to its fixed point, so what is left
-// in the patch is always inside its cone. The answer is still the rounds' own fixed point.
-class RoundMixer {
- public:
-  /// The unknowns (F_x, F_z, τ / r, c), N·s and m.
-  using Vector = Eigen::Matrix<double, 6, 1>;
-  /// The next round's input from this round's input x and output g = G(x).
-  Vector next(const Vector& x, const Vector& g) {
-    const Vector f = g - x;
-    if (count_ > 0 && f.squaredNorm() > 4.0 * f_.squaredNorm()) count_ = 0;
-    if (count_ > 0) {
-      df1_ = df0_, dg1_ = dg0_;
-      df0_ = f - f_, dg0_ = g - g_;
-    }
-    f_ = f, g_ = g;
-    const int depth = std::min(count_++, 2);
-    const double a00 = depth > 0 ? df0_.squaredNorm() : 0.0;
-    if (a00 == 0.0) return g;
-    const double b0 = df0_.dot(f);
-    if (depth == 2) {
-      const double a01 = df0_.dot(df1_), a11 = df1_.squaredNorm();
-      const double det = a00 * a11 - a01 * a01;
-      if (det > 1e-12 * a00 * a11) {  // the two changes are not (nearly) parallel
-        const double b1 = df1_.dot(f);
-        return g - ((a11 * b0 - a01 * b1) / det) * dg0_ - ((a00 * b1 - a01 * b0) / det) * dg1_;
-      }
-    }
-    return g - (b0 / a00) * dg0_;
-  }
-
- private:
-  int count_ = 0;  // rounds in the history since the last restart
-  // The last round's residual and output, and their changes over the last two rounds.
-  Vector f_ = Vector::Zero(), g_ = Vector::Zero();
-  Vector df0_ = Vector::Zero(), dg0_ = Vector::Zero();
-  Vector df1_ = Vector::Zero(), dg1_ = Vector::Zero();
-};
-
 }  // namespace
 
 /// Normal velocity each contact should leave with if it is pushed: −eᵢ v⁻ₙ for an approaching
@@ -133,7 +61,19 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
 // clamped to the cone |F| ≤ μ Σ jₙ (Stewart & Trinkle 1996 reduce to this for one patch).
 // Each round re-solves the normal impulses from the state before the impulse exchange, so the
 // load shifts to the leading edge of a sliding box instead of tipping it, and a flat slide
-// decelerates at exactly μ g.
+// decelerates at exactly μ g. The rounds are mixed (RoundMixer, friction_rounds.cpp), with
+// guards for a map with kinks:
+// - after kMixedRounds the rounds go on plain, for an exchange still far from its fixed point
+//   (mixing can circle a kink where plain rounds creep in);
+// - a mixed input that lifts the body off the floor (no load: friction's torque, extrapolated
+//   past the last cone, turns every vertex up) is dropped for the closest round's output, and
+//   the rounds go on plain. Before, the exchange ended there, with that friction applied and
+//   no normal impulse to bound it: 3 of the 2,936 sliding edges of the friction tests;
+// - an exchange the rounds leave more than kPolishFrom of its limit off takes a few Newton
+//   steps (polish);
+// - the last round applies the output of the round that came closest to its fixed point, so
+//   what is left in the patch is always inside its cone.
+// The answer is still the rounds' own fixed point.
 int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const Impulses& target,
             double mu, PatchFriction* patch) {
   if (set.count == 0) return 0;
@@ -149,89 +89,50 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   ActiveSetCache system(normal_sys);
   Impulses normal = solve_normal(s, k, set, system, target);
   if (mu <= 0.0) return set.count;
-  Eigen::Vector2d friction = Eigen::Vector2d::Zero();
-  double twist = 0.0;  // torsional impulse about the normal, N·m·s
-  const Vec3 up = Vec3::UnitY();
+  const FrictionRounds rounds(s0, k0, set, system, target, mu);
   const double lever = c.bounding_radius;  // m: the twist's scale among the unknowns
   RoundMixer mixer;
   constexpr int kRounds = 32;       // at most; most exchanges settle within 3–10
   constexpr int kMixedRounds = 16;  // then plain rounds, for an exchange still far off:
   constexpr double kFarOff = 1e-7;  // its closest residual above this part of μ Σ jₙ
-  // The output of the round closest to its fixed point (residual: |G(x) − x| over the
-  // friction and the twist / r, N·s), applied if the rounds end unsettled.
-  struct Closest {
-    double residual = INFINITY;
-    Eigen::Vector2d friction = Eigen::Vector2d::Zero();
-    double twist = 0.0;
-    Vec3 at = Vec3::Zero();
-    double limit = 0.0;
-  } closest;
-  Vec3 applied_at = Vec3::Zero();  // where `friction` was applied
+  constexpr double kPolishFrom = 1e-5;  // Newton for a closest residual above this part
+  ClosestRound closest;  // the output applied if the rounds end unsettled
+  bool plain = false;    // mixing given up (a mixed input lifted the body)
+  RoundInput in;         // what the last round applied: no friction yet
   for (int round = 0; round < kRounds; ++round) {
-    double total = 0.0;
-    Vec3 centroid = Vec3::Zero();
-    for (int i = 0; i < set.count; ++i) total += normal[i], centroid += normal[i] * set.r[i];
-    if (total <= 0.0) break;
-    centroid /= total;
-    if (round == 0) applied_at = centroid;  // no friction yet: where it was applied is moot
-    double radius = 0.0;  // load-weighted mean distance from the centroid in the floor plane
-    for (int i = 0; i < set.count; ++i) {
-      const Vec3 d = set.r[i] - centroid;
-      radius += normal[i] * std::hypot(d.x(), d.z());
+    const RoundOutput out = rounds.read(in, normal, k);
+    if (out.limit <= 0.0) {  // no load
+      if (round == 0 || plain || closest.residual == INFINITY) break;
+      plain = true;
+      in = closest.output;
+      normal = rounds.apply(in, s, k);
+      continue;
     }
-    radius /= total;
-    const Mat3 rx = skew(centroid);
-    const Mat3 mass3 = k.inv_mass * Mat3::Identity() - rx * k.inv_inertia * rx;
-    Eigen::Matrix2d kt;
-    kt << mass3(0, 0), mass3(0, 2), mass3(2, 0), mass3(2, 2);
-    const Vec3 u = k.point_velocity(centroid);
-    Eigen::Vector2d next = friction - kt.inverse() * Eigen::Vector2d(u.x(), u.z());
-    if (next.norm() > mu * total) next *= mu * total / next.norm();
-    // Torsional friction of the patch: a face spinning on the floor is braked by at most
-    // μ N times the mean lever of its load; a single point contact has none.
-    double next_twist = twist - k.w.y() / k.inv_inertia(1, 1);
-    next_twist = std::clamp(next_twist, -mu * total * radius, mu * total * radius);
-    const double moved = (next - friction).norm();
-    const double turned = std::abs(next_twist - twist);
-    const bool settled = moved <= 1e-13 * (1.0 + next.norm()) &&
-                         turned <= 1e-13 * (1.0 + std::abs(next_twist));
-    double residual = moved + turned / lever, limit = mu * total;
-    if (!settled && residual < closest.residual)
-      closest = {residual, next, next_twist, centroid, limit};
+    if (round == 0) in.at = out.next.at;  // no friction yet: where it was applied is moot
+    const double moved = (out.next.friction - in.friction).norm();
+    const double turned = std::abs(out.next.twist - in.twist);
+    const bool settled = moved <= 1e-13 * (1.0 + out.next.friction.norm()) &&
+                         turned <= 1e-13 * (1.0 + std::abs(out.next.twist));
+    double residual = moved + turned / lever, limit = out.limit;
+    if (!settled && residual < closest.residual) closest = {residual, out.next, out.limit};
     // Plain rounds cost a tenth of a μ = 1 landing's time when every unsettled exchange took
     // them; most of those were creeping within 1e-7 of their fixed point already.
     const bool close_enough =
         round >= kMixedRounds - 1 && closest.residual <= kFarOff * closest.limit;
-    Vec3 at = centroid;
     if (settled) {
-      friction = next;
-      twist = next_twist;
+      in = out.next;
     } else if (round == kRounds - 1 || close_enough) {
-      friction = closest.friction;
-      twist = closest.twist;
-      at = closest.at;
+      if (closest.residual > kPolishFrom * closest.limit) polish(rounds, lever, closest);
+      in = closest.output;
       residual = closest.residual;
       limit = closest.limit;
+    } else if (round < kMixedRounds && !plain) {
+      in = round_input(mixer.next(round_vector(in, lever), round_vector(out.next, lever)), lever);
     } else {
-      RoundMixer::Vector x, g;
-      // Entry by entry: a 2-vector streamed into the 6-vector sent GCC's bounds check down an
-      // AVX path that cannot run (-Warray-bounds).
-      x << friction.x(), friction.y(), twist / lever, applied_at.x(), applied_at.y(),
-          applied_at.z();
-      g << next.x(), next.y(), next_twist / lever, centroid.x(), centroid.y(), centroid.z();
-      const RoundMixer::Vector mixed = round < kMixedRounds ? mixer.next(x, g) : g;
-      friction = mixed.head<2>();
-      twist = lever * mixed(2);
-      at = mixed.tail<3>();
+      in = out.next;
     }
-    applied_at = at;
-    s = s0;
-    k = k0;
-    k.apply(s, at, Vec3(friction.x(), 0.0, friction.y()));
-    s.L += twist * up;
-    k.w += k.inv_inertia * (twist * up);
-    normal = solve_normal(s, k, set, system, target);
-    if (patch) *patch = {friction.norm(), limit, settled ? 0.0 : residual};
+    normal = rounds.apply(in, s, k);
+    if (patch) *patch = {in.friction.norm(), limit, settled ? 0.0 : residual};
     if (settled || close_enough) break;
   }
   return set.count;

@@ -2,6 +2,7 @@
 /// The floor's impulses on one box: the normal impulses of its touching vertices (an active-set
 /// solve) alternated with Coulomb friction on the contact patch. Pure functions; thread-safe.
 #include "floor_geometry.hpp"
+#include "friction_rounds.hpp"
 
 namespace tumble::floor_detail {
 
@@ -13,9 +14,6 @@ struct PatchFriction {
   /// twist over the body's bounding radius): 0 when its rounds settled to round-off.
   double unsettled = 0.0;
 };
-
-/// One normal impulse or target per touching vertex (N·s, m/s).
-using Impulses = std::array<double, kMaxPoints>;
 
 /// Normal velocity each contact should leave with if it is pushed: −eᵢ v⁻ₙ for an approaching
 /// contact (e = 0 below the rest speed, which ends a Zeno series), 0 for a resting one.
