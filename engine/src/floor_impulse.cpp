@@ -61,7 +61,7 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
 // clamped to the cone |F| ≤ μ Σ jₙ (Stewart & Trinkle 1996 reduce to this for one patch).
 // Each round re-solves the normal impulses from the state before the impulse exchange, so the
 // load shifts to the leading edge of a sliding box instead of tipping it, and a flat slide
-// decelerates at exactly μ g. The rounds are mixed (RoundMixer, friction_rounds.cpp), with
+// decelerates at exactly μ g. The rounds are mixed (RoundMixer, friction_rounds.hpp), with
 // guards for a map with kinks:
 // - after kMixedRounds the rounds go on plain, for an exchange still far from its fixed point
 //   (mixing can circle a kink where plain rounds creep in);
