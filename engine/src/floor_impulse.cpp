@@ -70,7 +70,8 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
 //   the rounds go on plain. Before, the exchange ended there, with that friction applied and
 //   no normal impulse to bound it: 3 of the 2,936 sliding edges of the friction tests;
 // - an exchange the rounds leave more than kPolishFrom of its limit off takes a few Newton
-//   steps (polish);
+//   steps (polish), and if it is still that far off (Newton stalls where its differences
+//   straddle a kink), kCreepRounds more plain rounds from the closest round, and Newton again;
 // - the last round applies the output of the round that came closest to its fixed point, so
 //   what is left in the patch is always inside its cone.
 // The answer is still the rounds' own fixed point.
@@ -95,11 +96,12 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   constexpr int kRounds = 32;       // at most; most exchanges settle within 3–10
   constexpr int kMixedRounds = 16;  // then plain rounds, for an exchange still far off:
   constexpr double kFarOff = 1e-7;  // its closest residual above this part of μ Σ jₙ
-  constexpr double kPolishFrom = 1e-5;  // Newton for a closest residual above this part
+  constexpr double kPolishFrom = 1e-5;  // Newton for a closest residual above this part,
+  constexpr int kCreepRounds = 64;      // then as many more plain rounds if it stays so
   ClosestRound closest;  // the output applied if the rounds end unsettled
   bool plain = false;    // mixing given up (a mixed input lifted the body)
   RoundInput in;         // what the last round applied: no friction yet
-  for (int round = 0; round < kRounds; ++round) {
+  for (int round = 0, last = kRounds - 1; round <= last; ++round) {
     const RoundOutput out = rounds.read(in, normal, k);
     if (out.limit <= 0.0) {  // no load
       if (round == 0 || plain || closest.residual == INFINITY) break;
@@ -121,8 +123,15 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
         round >= kMixedRounds - 1 && closest.residual <= kFarOff * closest.limit;
     if (settled) {
       in = out.next;
-    } else if (round == kRounds - 1 || close_enough) {
+    } else if (round == last || close_enough) {
       if (closest.residual > kPolishFrom * closest.limit) polish(rounds, lever, closest);
+      if (round == kRounds - 1 && closest.residual > kPolishFrom * closest.limit) {
+        last += kCreepRounds;  // Newton stalled on a kink: plain rounds creep in
+        plain = true;
+        in = closest.output;
+        normal = rounds.apply(in, s, k);
+        continue;
+      }
       in = closest.output;
       residual = closest.residual;
       limit = closest.limit;
