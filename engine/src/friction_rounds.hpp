@@ -57,6 +57,7 @@ inline RoundVector round_vector(const RoundInput& x, double lever) {
   v << x.friction.x(), x.friction.y(), x.twist / lever, x.at.x(), x.at.y(), x.at.z();
   return v;
 }
+
 /// The input of vector v; the inverse of round_vector.
 inline RoundInput round_input(const RoundVector& v, double lever) {
   return {v.head<2>(), lever * v(2), v.tail<3>()};
