@@ -68,7 +68,9 @@ Impulses normal_targets(const Kinematics& k, const ContactSet& set, double e,
 // - a mixed input that lifts the body off the floor (no load: friction's torque, extrapolated
 //   past the last cone, turns every vertex up) is dropped for the closest round's output, and
 //   the rounds go on plain. Before, the exchange ended there, with that friction applied and
-//   no normal impulse to bound it: 3 of the 2,936 sliding edges of the friction tests;
+//   no normal impulse to bound it: 3 of the 2,936 sliding edges of the friction tests. Should
+//   a plain round lift it too (none has, in 30,000 such edges and a 10,000-cube landing), the
+//   exchange ends without friction;
 // - an exchange the rounds leave more than kPolishFrom of its limit off takes a few Newton
 //   steps (polish), and if it is still that far off (Newton stalls where its differences
 //   straddle a kink), kCreepRounds more plain rounds from the closest round, and Newton again;
@@ -104,7 +106,12 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   for (int round = 0, last = kRounds - 1; round <= last; ++round) {
     const RoundOutput out = rounds.read(in, normal, k);
     if (out.limit <= 0.0) {  // no load
-      if (round == 0 || plain || closest.residual == INFINITY) break;
+      if (round == 0) break;  // the body leaves the floor: no friction
+      if (plain || closest.residual == INFINITY) {  // even the closest round's lifts it
+        normal = rounds.apply(RoundInput{}, s, k);  // no friction rather than no load
+        if (patch) *patch = {};
+        break;
+      }
       plain = true;
       in = closest.output;
       normal = rounds.apply(in, s, k);
