@@ -103,6 +103,12 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
   ClosestRound closest;  // the output applied if the rounds end unsettled
   bool plain = false;    // mixing given up (a mixed input lifted the body)
   RoundInput in;         // what the last round applied: no friction yet
+  // Back to the closest round's output, with plain rounds from there.
+  auto plain_from_closest = [&] {
+    plain = true;
+    in = closest.output;
+    normal = rounds.apply(in, s, k);
+  };
   for (int round = 0, last = kRounds - 1; round <= last; ++round) {
     const RoundOutput out = rounds.read(in, normal, k);
     if (out.limit <= 0.0) {  // no load
@@ -112,9 +118,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
         if (patch) *patch = {};
         break;
       }
-      plain = true;
-      in = closest.output;
-      normal = rounds.apply(in, s, k);
+      plain_from_closest();
       continue;
     }
     if (round == 0) in.at = out.next.at;  // no friction yet: where it was applied is moot
@@ -134,9 +138,7 @@ int resolve(BodyState& s, const BodyConstants& c, const ContactSet& set, const I
       if (closest.residual > kPolishFrom * closest.limit) polish(rounds, lever, closest);
       if (round == kRounds - 1 && closest.residual > kPolishFrom * closest.limit) {
         last += kCreepRounds;  // Newton stalled on a kink: plain rounds creep in
-        plain = true;
-        in = closest.output;
-        normal = rounds.apply(in, s, k);
+        plain_from_closest();
         continue;
       }
       in = closest.output;
