@@ -51,7 +51,7 @@ struct SolverSettings {
   int velocity_iterations = 10;     ///< Sequential-impulse sweeps.
   int position_iterations = 4;      ///< Split-impulse sweeps.
   /// The first of several sweeps runs backward (top of the stacks first), the rest in contact
-  /// order (floor contacts first): see `sweep` in contact_solver.cpp.
+  /// order (floor contacts first): see `sweep` in contact_passes.cpp.
   bool first_sweep_backward = true;
   double slop = 2e-4;               ///< Penetration left alone, m.
   double position_gain = 0.4;       ///< Fraction of the penetration beyond slop removed per step.

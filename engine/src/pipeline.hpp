@@ -8,7 +8,8 @@
 ///   narrow_phase  → narrow_phase.cpp  box–box manifolds; box–floor manifolds of bodies in them
 ///   islands       → islands.cpp       bodies linked by contacts; a lone body is an island of one
 ///   contact_solve → contact_solve.cpp  impacts, friction, non-penetration of the islands (the
-///                                     solver: contact_solver.cpp, contact_rows.cpp,
+///                                     passes: contact_passes.cpp; the solver's work per
+///                                     contact: contact_solver.cpp, contact_rows.cpp,
 ///                                     shock_propagation.cpp)
 ///   flight        → flight.cpp        every awake body moved over dt; a lone body's finalize
 ///                                     and sleep rules applied at once (finalize_body,

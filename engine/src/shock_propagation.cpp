@@ -157,7 +157,7 @@ void Solver::order_groups_by_wave(std::size_t groups, std::uint32_t last) {
 }
 
 // Waves 1 … last are the phases of one job (pool.for_each_phase) without barriers, as the
-// solver's sweeps run (contact_solver.cpp): a solve waits only for its own bodies' earlier
+// solver's sweeps run (contact_passes.cpp): a solve waits only for its own bodies' earlier
 // solves. A barrier per wave held both threads for the slowest chunk of each of `pile`'s
 // waves. The turns count on from the solve's sweeps (turn_base_), as theirs do. The job
 // beside, if any, is phase 0, a single chunk: the thread that takes it meets the waves once it

@@ -1,6 +1,7 @@
 #pragma once
-/// The contact solver's working object, shared by the files of the solve (contact_solver.cpp,
-/// contact_rows.cpp, shock_propagation.cpp); not part of the engine's interface.
+/// The contact solver's working object, shared by the files of the solve (contact_passes.cpp,
+/// contact_solver.cpp, contact_rows.cpp, shock_propagation.cpp); not part of the engine's
+/// interface.
 #include <cmath>
 #include <span>
 #include <utility>
@@ -26,7 +27,7 @@ struct Motion {
 };
 
 /// One step's contact solve over the solver bodies: their velocities, the contacts' rows and
-/// the passes of solve_contacts (contact_solver.cpp), the rows (contact_rows.cpp) and shock
+/// the passes of solve_contacts (contact_passes.cpp), the rows (contact_rows.cpp) and shock
 /// propagation (shock_propagation.cpp). Lives for one call of solve_contacts; its buffers are
 /// the caller's SolverScratch. A pass over contacts of one colour may run on several threads.
 class Solver {
