@@ -158,12 +158,12 @@ test('viewer against the real server: pixels, HUD, pause, step, click-kick, reco
       const corners = await page.evaluate((points) => points.map((p) => window.tumble.worldToScreen(p)),
         boxCorners(body.position, body.orientation, size));
       const xs = corners.map((c) => c.x), ys = corners.map((c) => c.y), margin = 4;
-      const inside = paused.x > Math.min(...xs) - margin && paused.x < Math.max(...xs) + margin &&
-                     paused.y > Math.min(...ys) - margin && paused.y < Math.max(...ys) + margin;
+      const [left, right, top, bottom] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+      const inside = paused.x > left - margin && paused.x < right + margin &&
+                     paused.y > top - margin && paused.y < bottom + margin;
       assert.ok(inside, `orange pixels (${paused.count}) centred at (${paused.x.toFixed(0)}, ` +
                 `${paused.y.toFixed(0)}) px, outside the box's projected corners x ` +
-                `${Math.min(...xs).toFixed(0)}..${Math.max(...xs).toFixed(0)}, y ` +
-                `${Math.min(...ys).toFixed(0)}..${Math.max(...ys).toFixed(0)}`);
+                `${left.toFixed(0)}..${right.toFixed(0)}, y ${top.toFixed(0)}..${bottom.toFixed(0)}`);
     });
 
     await t.test('Step advances a paused simulation by one step; the integrator menu switches it', async () => {
