@@ -1,5 +1,7 @@
 #include "free_rotation.hpp"
 
+#include "elliptic_flow.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -128,7 +130,7 @@ std::array<int, 3> axes_by_moment(const Vec3& inertia) {
   return a;
 }
 
-// The general (three distinct moments) exact flow: elliptic_flow and general_flow.
+// The general (three distinct moments) exact flow: elliptic::reduce, phase and assemble.
 //
 // Why: in a canonical body frame (a signed permutation C of the body axes, proper, with the
 // moments J1, J2, J3 ordered so that axis 3 is the one the polhode encircles and m3 > 0),
@@ -153,23 +155,15 @@ std::array<int, 3> axes_by_moment(const Vec3& inertia) {
 // the addition theorems give the end point and the integral over [u0, u0 + τ]; see
 // increment_flow. Longer times reduce u by half periods instead (periodic_flow).
 
-// Longest increment λt handled by increment_flow: below K (≥ π/2) so that Π(τ) has the
-// Carlson form above, and at most five doublings in jacobi_near_zero.
-constexpr double kMaxIncrement = 1.0;
-
-struct Jacobi {
-  double sn = 0.0, cn = 1.0, dn = 1.0;
-};
+using elliptic::kMaxIncrement;
+using Jacobi = elliptic::Jacobi<double>;
+using Polhode = elliptic::Polhode<double>;
 
 // Carlson's R_C(1, 1 + e) for e > −1: atan(√e)/√e, or atanh(√−e)/√−e (DLMF 19.2.18–19). The
 // duplication below calls it with |e| ~ 1e-9 for a step, where the alternating series
-// Σ (−e)ʲ/(2j + 1) to e⁵ is exact to round-off (its first omitted term is below e⁶/13).
+// (elliptic::rc1_series) is exact to round-off.
 double carlson_rc1(double e) {
-  if (std::abs(e) < 1e-3) {
-    constexpr double c3 = 1.0 / 3.0, c5 = 1.0 / 5.0, c7 = 1.0 / 7.0, c9 = 1.0 / 9.0,
-                     c11 = 1.0 / 11.0;
-    return 1.0 + e * (-c3 + e * (c5 + e * (-c7 + e * (c9 - e * c11))));
-  }
+  if (std::abs(e) < 1e-3) return elliptic::rc1_series(e);
   if (e > 0.0) {
     const double r = std::sqrt(e);
     return std::atan(r) / r;
@@ -186,8 +180,9 @@ double carlson_rc1(double e) {
 // against Boost's 59 ns for the same arguments (which also checks its domain and sorts them).
 // Relative error measured against Boost in long double: 4e-16 over steps, 1e-15 over
 // arguments from 0 to 100.
+constexpr double kSpreadForSeries = 1.7e-3;  // (2⁻⁵³ / 4)^(1/6)
+
 double carlson_rj(double x, double y, double z, double p) {
-  constexpr double kSpreadForSeries = 1.7e-3;  // (2⁻⁵³ / 4)^(1/6)
   const double a0 = 0.2 * (x + y + z + 2.0 * p);
   const double delta = (p - x) * (p - y) * (p - z);
   const double spread =
@@ -196,9 +191,8 @@ double carlson_rj(double x, double y, double z, double p) {
   double a = a0, scale = 1.0, sum = 0.0;  // scale = 4⁻ᵐ
   double xm = x, ym = y, zm = z, pm = p;
   for (int m = 0; m < 40 && scale * spread >= a; ++m) {
-    const double sx = std::sqrt(xm), sy = std::sqrt(ym), sz = std::sqrt(zm), sp = std::sqrt(pm);
-    const double lam = sx * sy + sx * sz + sy * sz;
-    const double d = (sp + sx) * (sp + sy) * (sp + sz);
+    double d;
+    const double lam = elliptic::rj_duplication(xm, ym, zm, pm, d);
     sum += scale * carlson_rc1(scale * scale * scale * delta / (d * d)) / d;
     a = 0.25 * (a + lam);
     xm = 0.25 * (xm + lam);
@@ -207,89 +201,22 @@ double carlson_rj(double x, double y, double z, double p) {
     pm = 0.25 * (pm + lam);
     scale *= 0.25;
   }
-  const double inv = scale / a;
-  const double X = (a0 - x) * inv, Y = (a0 - y) * inv, Z = (a0 - z) * inv;
-  const double P = -0.5 * (X + Y + Z);
-  const double xyz = X * Y * Z, P2 = P * P;
-  const double E2 = X * Y + X * Z + Y * Z - 3.0 * P2;
-  const double E3 = xyz + 2.0 * E2 * P + 4.0 * P2 * P;
-  const double E4 = (2.0 * xyz + E2 * P + 3.0 * P2 * P) * P;
-  const double E5 = xyz * P2;
-  constexpr double c2 = 3.0 / 14.0, c3 = 1.0 / 6.0, c22 = 9.0 / 88.0, c4 = 3.0 / 22.0,
-                   c23 = 9.0 / 52.0, c5 = 3.0 / 26.0;
-  const double series =
-      1.0 - c2 * E2 + c3 * E3 + c22 * E2 * E2 - c4 * E4 - c23 * E2 * E3 + c5 * E5;
-  return scale * series / (a * std::sqrt(a)) + 6.0 * sum;
+  return elliptic::rj_tail(x, y, z, a0, a, scale, sum);
 }
 
 // sn, cn, dn at u (|u| ≤ kMaxIncrement) for parameter k² ≤ 1: halve u until |u| ≤ 1/32, sum the
-// Maclaurin series (DLMF 22.10.4–6; the u⁸ and u⁹ coefficients checked against mpmath's Taylor
-// coefficients), whose first omitted term is below 0.011 |u|¹⁰ ≈ 1e-17, and double back:
-// sn 2u = 2 s c d / (1 − k² s⁴), cn 2u = (c² − s² d²) / (1 − k² s⁴),
-// dn 2u = (d² − k² s² c²) / (1 − k² s⁴) (DLMF 22.8.1–3 with v = u). No transcendental call;
-// well conditioned for every k², including k² = 1 (tanh, sech, sech).
+// Maclaurin series (elliptic::jacobi_series), and double back (elliptic::jacobi_doubled). No
+// transcendental call; well conditioned for every k², including k² = 1 (tanh, sech, sech).
 Jacobi jacobi_near_zero(double u, double k2) {
   int doublings = 0;
   while (std::abs(u) > 1.0 / 32.0 && doublings < 8) {
     u *= 0.5;
     ++doublings;
   }
-  constexpr double f3 = 1.0 / 6.0, f4 = 1.0 / 24.0, f5 = 1.0 / 120.0, f6 = 1.0 / 720.0,
-                   f7 = 1.0 / 5040.0, f8 = 1.0 / 40320.0, f9 = 1.0 / 362880.0;  // 1/j!
-  const double u2 = u * u, k4 = k2 * k2, k6 = k4 * k2;
-  Jacobi f;
-  f.sn = u * (1.0 + u2 * (-(1.0 + k2) * f3 +
-                          u2 * ((1.0 + 14.0 * k2 + k4) * f5 +
-                                u2 * (-(1.0 + 135.0 * k2 + 135.0 * k4 + k6) * f7 +
-                                      u2 * (1.0 + 1228.0 * k2 + 5478.0 * k4 + 1228.0 * k6 +
-                                            k4 * k4) * f9))));
-  f.cn = 1.0 + u2 * (-0.5 + u2 * ((1.0 + 4.0 * k2) * f4 +
-                                  u2 * (-(1.0 + 44.0 * k2 + 16.0 * k4) * f6 +
-                                        u2 * (1.0 + 408.0 * k2 + 912.0 * k4 + 64.0 * k6) * f8)));
-  f.dn = 1.0 + u2 * k2 * (-0.5 + u2 * ((4.0 + k2) * f4 +
-                                       u2 * (-(16.0 + 44.0 * k2 + k4) * f6 +
-                                             u2 * (64.0 + 912.0 * k2 + 408.0 * k4 + k6) * f8)));
-  for (int i = 0; i < doublings; ++i) {
-    const double s2 = f.sn * f.sn, c2 = f.cn * f.cn, d2 = f.dn * f.dn;
-    const double inv = 1.0 / (1.0 - k2 * s2 * s2);
-    f.sn = 2.0 * f.sn * f.cn * f.dn * inv;
-    f.cn = (c2 - s2 * d2) * inv;
-    f.dn = (d2 - k2 * s2 * c2) * inv;
-  }
+  Jacobi f = elliptic::jacobi_series(u, k2);
+  for (int i = 0; i < doublings; ++i) f = elliptic::jacobi_doubled(f, k2);
   return f;
 }
-
-// The polhode in canonical axes: amplitudes a_i, rate λ (1/s), k², k'², n, s, and sn, cn, dn
-// of the start phase u0, read off m0 (m1 = a1 cn u0, m2 = s a2 sn u0).
-struct Polhode {
-  double a1 = 0.0, a2 = 0.0, a3 = 0.0, lambda = 0.0, k2 = 0.0, kc2 = 0.0, n = 0.0, s = 1.0;
-  // On the separatrix cn = sech > 0: use the symmetry (m1, m2) → (−m1, −m2) if m1 < 0.
-  double sigma1 = 1.0;
-  Jacobi start;
-
-  Polhode(const Vec3& m0, double J1, double J2, double J3, double D1, double D2, double D3) {
-    const double r31 = 1.0 / (J3 - J1), r32 = 1.0 / (J3 - J2), r32d1 = r32 / D1;
-    a1 = std::sqrt(J1 * D3 * r31);
-    a2 = std::sqrt(J2 * D3 * r32);
-    a3 = std::sqrt(J3 * D1 * r31);
-    lambda = std::sqrt((J3 - J2) * D1 / (J1 * J2 * J3));
-    k2 = std::min(1.0, (J2 - J1) * D3 * r32d1);
-    kc2 = std::max(0.0, (J3 - J1) * D2 * r32d1);
-    n = -J3 * (J2 - J1) * r32 / J1;
-    s = J3 > J2 ? 1.0 : -1.0;
-    sigma1 = kc2 == 0.0 && m0[0] < 0.0 ? -1.0 : 1.0;
-    const double x = sigma1 * m0[0] / a1, y = sigma1 * s * m0[1] / a2;
-    const double inv_h = 1.0 / std::sqrt(x * x + y * y);  // 1 up to round-off
-    start.sn = y * inv_h;
-    start.cn = x * inv_h;
-    // dn² = cn² + k'² sn² has no cancellation, unlike 1 − k² sn² near u = K, k → 1.
-    start.dn = std::sqrt(start.cn * start.cn + kc2 * start.sn * start.sn);
-  }
-
-  Vec3 momentum(const Jacobi& f) const {
-    return Vec3(sigma1 * a1 * f.cn, sigma1 * s * a2 * f.sn, a3 * f.dn);
-  }
-};
 
 // One increment τ = λt (|τ| ≤ kMaxIncrement): returns sn, cn, dn at u0 + τ, and in `bracket`
 // the (3/n)[Π(u) − u] from u0 to u0 + τ of the comment above.
@@ -302,23 +229,13 @@ struct Polhode {
 // quarter periods; sn, cn at u0 + τ follow from DLMF 22.8.1–2. Both are analytic in u0, so no
 // half periods are counted.
 Jacobi increment_flow(const Polhode& p, double tau, double& bracket) {
-  const Jacobi& f0 = p.start;
   const Jacobi f1 = jacobi_near_zero(tau, p.k2);
-  const double s01 = f0.sn * f1.sn;
-  const double inv = 1.0 / (1.0 - p.k2 * s01 * s01);
-  Jacobi f;
-  f.sn = (f0.sn * f1.cn * f1.dn + f1.sn * f0.cn * f0.dn) * inv;
-  f.cn = (f0.cn * f1.cn - s01 * f0.dn * f1.dn) * inv;
-  // dn from cn and sn (dn² = cn² + k'² sn²), not the third addition formula: this puts m(t)
-  // on the energy surface with M² − 2E J2 exact to relative round-off, as periodic_flow does.
-  f.dn = std::sqrt(f.cn * f.cn + p.kc2 * f.sn * f.sn);
+  double s01, w;
+  const Jacobi f = elliptic::jacobi_added(p, f1, s01);
   const double rj = carlson_rj(f1.cn * f1.cn, f1.dn * f1.dn, 1.0, 1.0 - p.n * f1.sn * f1.sn);
-  const double X = s01 * f.sn;
-  const double A = 1.0 - p.n * (f.sn * f.sn - s01 * f.cn * f.dn);
-  const double w = std::sqrt(-p.n * (p.k2 - p.n) * (1.0 - p.n));
   // atan z = z R_C(1, 1 + z²): z is O(τ) small over a step, where carlson_rc1 is a short
   // series instead of the library's atan.
-  const double z = w * X / A;
+  const double z = elliptic::bracket_z(p, f, s01, w);
   bracket = f1.sn * f1.sn * f1.sn * rj + 3.0 * z * carlson_rc1(z * z) / w;
   return f;
 }
@@ -365,9 +282,26 @@ Jacobi periodic_flow(const Polhode& p, double tau, double& bracket) {
   return f;
 }
 
-// R(t) = R0 Cᵀ P(m0)ᵀ Rz(ψ(t)) P(m(t)) C of general_flow for moments J1, J2, J3 (axis 3
-// encircled, m0[2] > 0, m0[0]² + m0[1]² > 0), D_i as defined there, C given by `perm` and
-// `sgn`, R0 the start attitude and L the world momentum.
+}  // namespace
+
+namespace elliptic {
+
+Phase phase(const Case& e, double t) {
+  const Polhode p =
+      make_polhode(e.m0[0], e.m0[1], e.J1, e.J2, e.J3, e.D1, e.D2, e.D3);
+  const double tau = p.lambda * t;
+  double bracket = 0.0;
+  const Jacobi f = std::abs(tau) <= kMaxIncrement ? increment_flow(p, tau, bracket)
+                                                  : periodic_flow(p, tau, bracket);
+  const double M = e.m0.norm();
+  const double psi = psi_of(M, t, e.J1, e.J2, e.J3, p.lambda, bracket);
+  Phase out{f.sn, f.cn, f.dn, p.a1, p.a2, p.a3, p.sigma1, p.s, 0.0, 0.0, 1.0 / M};
+  small_angle_sin_cos(psi, out.sin_psi, out.cos_psi);
+  return out;
+}
+
+// R(t) = R0 Cᵀ P(m0)ᵀ Rz(ψ(t)) P(m(t)) C of the comment above (axis 3 encircled, m0[2] > 0,
+// m0[0]² + m0[1]² > 0), C given by `perm` and `sgn`.
 // Why the product is formed so: W = R0 Cᵀ P(m0)ᵀ carries the rows of P(m0) into the world,
 // where they are L/M, (m0[1] c1 − m0[0] c2)/ρ (c_i = R0 Cᵀ ê_i, columns of R0 up to sign) and
 // the cross product of those two. That replaces building P(m0) and one of the three 3×3
@@ -376,39 +310,33 @@ Jacobi periodic_flow(const Polhode& p, double tau, double& bracket) {
 // The second row is taken from m0's components, as P(m0) did, not as (L × c3)/ρ: near a
 // steady spin ρ is round-off small, and only m0's own components give it the direction
 // that P(m(t)) continues.
-Mat3 elliptic_flow(const Vec3& m0, double J1, double J2, double J3, double D1, double D2,
-                   double D3, double t, const Mat3& R0, const Vec3& L,
-                   const std::array<int, 3>& perm, const std::array<double, 3>& sgn) {
-  const Polhode p(m0, J1, J2, J3, D1, D2, D3);
-  const double tau = p.lambda * t;
-  double bracket = 0.0;
-  const Jacobi f = std::abs(tau) <= kMaxIncrement ? increment_flow(p, tau, bracket)
-                                                  : periodic_flow(p, tau, bracket);
-  const double M = m0.norm(), inv_M = 1.0 / M;
-  const double c = -M * (J3 - J1) * (J2 - J1) / (3.0 * p.lambda * J1 * J1 * (J3 - J2));
-  const double psi = M * t / J1 + c * bracket;
-  double cos_psi, sin_psi;
-  small_angle_sin_cos(psi, sin_psi, cos_psi);
+Mat3 assemble(const Case& e, const Phase& f, const Mat3& R0, const Vec3& L) {
+  const Vec3& m0 = e.m0;
   const double inv_rho = 1.0 / std::sqrt(m0[0] * m0[0] + m0[1] * m0[1]);
-  const Vec3 w3 = inv_M * L;
-  const Vec3 w1 = inv_rho * ((sgn[0] * m0[1]) * R0.col(perm[0]) -
-                             (sgn[1] * m0[0]) * R0.col(perm[1]));
+  const Vec3 w3 = f.inv_M * L;
+  const Vec3 w1 = inv_rho * ((e.sgn[0] * m0[1]) * R0.col(e.perm[0]) -
+                             (e.sgn[1] * m0[0]) * R0.col(e.perm[1]));
   const Vec3 w2 = w3.cross(w1);
   // W Rz(ψ), then its product with P(m(t)).
   Mat3 w;
-  w.col(0) = cos_psi * w1 + sin_psi * w2;
-  w.col(1) = cos_psi * w2 - sin_psi * w1;
+  w.col(0) = f.cos_psi * w1 + f.sin_psi * w2;
+  w.col(1) = f.cos_psi * w2 - f.sin_psi * w1;
   w.col(2) = w3;
   // |m(t)| = M up to round-off. Normalising by |m(t)| itself puts a square root and a
   // division more at the end of the chain: 20 ns a call (docs/engine.md, "Tried").
-  const Mat3 p1 = momentum_frame(p.momentum(f), inv_M);
+  const Vec3 m(f.sigma1 * f.a1 * f.cn, f.sigma1 * f.s * f.a2 * f.sn, f.a3 * f.dn);
+  const Mat3 p1 = momentum_frame(m, f.inv_M);
   Mat3 p1c;  // P(m(t)) C: columns back on the body axes
-  for (int i = 0; i < 3; ++i) p1c.col(perm[i]) = sgn[i] * p1.col(i);
+  for (int i = 0; i < 3; ++i) p1c.col(e.perm[i]) = e.sgn[i] * p1.col(i);
   return w * p1c;
 }
 
-Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
-                  const std::array<int, 3>& sorted) {
+namespace {
+
+// The general case of `reduce`: canonical axes, and the steady spins that need no elliptic
+// functions.
+bool reduce_general(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
+                    const std::array<int, 3>& sorted, Mat3& out, Case& e) {
   const Vec3 mb = R.transpose() * L;
   const double Ib = inertia[sorted[1]];
   // M² − 2E·I_mid, from the two outer moments only.
@@ -420,13 +348,14 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   const double J1 = inertia[perm[0]], J2 = inertia[perm[1]], J3 = inertia[perm[2]];
   // Steady spin about the middle axis (the unstable equilibrium): a plain rotation.
   if (mb[perm[0]] == 0.0 && mb[perm[2]] == 0.0) {
-    return R * axis_rotation(perm[1], t * mb[perm[1]] / J2);
+    out = R * axis_rotation(perm[1], t * mb[perm[1]] / J2);
+    return false;
   }
   // Signs: flip axes 2 and 3 so that m3 > 0, and flip axis 2 once more if the permutation is odd.
   const bool odd = (perm[0] + 1) % 3 != perm[1];
   std::array<double, 3> sgn{1.0, 1.0, mb[perm[2]] < 0.0 ? -1.0 : 1.0};
   sgn[1] = odd ? -sgn[2] : sgn[2];
-  Vec3 m0(sgn[0] * mb[perm[0]], sgn[1] * mb[perm[1]], sgn[2] * mb[perm[2]]);
+  const Vec3 m0(sgn[0] * mb[perm[0]], sgn[1] * mb[perm[1]], sgn[2] * mb[perm[2]]);
 
   const double q1 = m0[0] * m0[0] / J1, q2 = m0[1] * m0[1] / J2, q3 = m0[2] * m0[2] / J3;
   const double D3 = q1 * (J3 - J1) + q2 * (J3 - J2);  // 2E J3 − M²
@@ -436,21 +365,27 @@ Mat3 general_flow(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   if (D3 / (J3 - J1) <= 0.0 || m0[0] * m0[0] + m0[1] * m0[1] == 0.0) {
     // Steady spin about canonical axis 3, that is sgn[2] times body axis perm[2]: a turn
     // about body axis perm[2] by t mb[perm[2]] / J3 (mb[perm[2]] = sgn[2] m0[2]).
-    return R * axis_rotation(perm[2], t * mb[perm[2]] / J3);
+    out = R * axis_rotation(perm[2], t * mb[perm[2]] / J3);
+    return false;
   }
-  return elliptic_flow(m0, J1, J2, J3, D1, D2, D3, t, R, L, perm, sgn);
+  e = Case{m0, J1, J2, J3, D1, D2, D3, perm, sgn};
+  return true;
 }
 
 }  // namespace
 
-Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
-  if (L.squaredNorm() == 0.0 || t == 0.0) return R;
+bool reduce(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& out, Case& e) {
+  if (L.squaredNorm() == 0.0 || t == 0.0) {
+    out = R;
+    return false;
+  }
   const std::array<int, 3> sorted = axes_by_moment(inertia);
   const double lo = inertia[sorted[0]], mid = inertia[sorted[1]], hi = inertia[sorted[2]];
   const double tol = kEqualMoments * hi;
   if (hi - lo <= tol) {
     // Sphere-like body: ω = L / I is constant in the world frame.
-    return rotation_from_vector(t * L / mid) * R;
+    out = rotation_from_vector(t * L / mid) * R;
+    return false;
   }
   if (mid - lo <= tol || hi - mid <= tol) {
     // Regular precession (Landau & Lifshitz §33): ω = L/I⊥ + (1/I_k − 1/I⊥) m_k e_k, and the two
@@ -459,9 +394,19 @@ Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, doub
     const double i_perp = mid - lo <= tol ? 0.5 * (lo + mid) : 0.5 * (mid + hi);
     const double mk = R.col(k).dot(L);
     const double theta = t * (1.0 / inertia[k] - 1.0 / i_perp) * mk;
-    return rotation_from_vector(t * L / i_perp) * R * axis_rotation(k, theta);
+    out = rotation_from_vector(t * L / i_perp) * R * axis_rotation(k, theta);
+    return false;
   }
-  return general_flow(inertia, R, L, t, sorted);
+  return reduce_general(inertia, R, L, t, sorted, out, e);
+}
+
+}  // namespace elliptic
+
+Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
+  Mat3 out;
+  elliptic::Case e;
+  if (!elliptic::reduce(inertia, R, L, t, out, e)) return out;
+  return elliptic::assemble(e, elliptic::phase(e, t), R, L);
 }
 
 // Symmetric (Strang) composition of the three exact axis flows (McLachlan 1993; Dullweber,
