@@ -32,11 +32,18 @@ struct Case {
   std::array<double, 3> sgn;
 };
 
-/// What the rotation is assembled from: sn, cn, dn at the end of the step, the polhode's
-/// amplitudes and signs, cos ψ and sin ψ, and 1/|m0|.
-struct Phase {
-  double sn, cn, dn, a1, a2, a3, sigma1, s, cos_psi, sin_psi, inv_M;
+/// What the rotation is assembled from: the scalars of P(m(t)) and of W's second row
+/// (frame_scalars), cos ψ and sin ψ, and 1/|m0|.
+template <class T>
+struct PhaseOf {
+  T m[3];      ///< m(t) in canonical axes, kg·m²/s.
+  T inv_rho;   ///< 1/ρ, ρ = √(m1² + m2²) of m(t).
+  T rho;       ///< ρ of m(t).
+  T z;         ///< m3 / (|m| ρ) of m(t).
+  T inv_rho0;  ///< 1/ρ of m0.
+  T cos_psi, sin_psi, inv_M;
 };
+using Phase = PhaseOf<double>;
 
 /// The polhode in canonical axes: amplitudes a_i, rate λ (1/s), k², k'², n, s, σ1, and sn,
 /// cn, dn of the start phase u0, read off m0 (m1 = σ1 a1 cn u0, m2 = σ1 s a2 sn u0). On the
@@ -117,6 +124,10 @@ Jacobi<T> jacobi_added(const Polhode<T>& p, const Jacobi<T>& f1, T& s01) {
   return f;
 }
 
+/// Carlson's R_J ends its duplications once the arguments' spread is below this fraction of
+/// their mean, (2⁻⁵³ / 4)^(1/6): the fifth-order Taylor polynomial is then exact to 2⁻⁵³.
+inline constexpr double kSpreadForSeries = 1.7e-3;
+
 /// Carlson's R_C(1, 1 + e) by its alternating series Σ (−e)ʲ/(2j + 1) to e⁵, exact to
 /// round-off for |e| < 1e-3 (the first omitted term is below e⁶/13).
 template <class T>
@@ -161,6 +172,24 @@ T bracket_z(const Polhode<T>& p, const Jacobi<T>& f, T s01, T& w) {
   const T A = 1.0 - p.n * (f.sn * f.sn - s01 * f.cn * f.dn);
   w = root(-p.n * (p.k2 - p.n) * (1.0 - p.n));
   return w * X / A;
+}
+
+/// The phase's scalars that P(m(t)) and W need, each behind a square root and a division:
+/// m(t) = (σ1 a1 cn, σ1 s a2 sn, a3 dn) from sn, cn, dn at u0 + τ, its 1/ρ, ρ and z, and 1/ρ
+/// of m0 = (m1, m2, ·). cos ψ, sin ψ are left to the caller.
+template <class T>
+PhaseOf<T> frame_scalars(const Polhode<T>& p, const Jacobi<T>& f, T m1, T m2, T inv_M) {
+  PhaseOf<T> r;
+  r.m[0] = p.sigma1 * p.a1 * f.cn;
+  r.m[1] = p.sigma1 * p.s * p.a2 * f.sn;
+  r.m[2] = p.a3 * f.dn;
+  const T rho2 = r.m[0] * r.m[0] + r.m[1] * r.m[1];
+  r.inv_rho = 1.0 / root(rho2);
+  r.rho = rho2 * r.inv_rho;
+  r.z = r.m[2] * inv_M * r.inv_rho;
+  r.inv_rho0 = 1.0 / root(m1 * m1 + m2 * m2);
+  r.inv_M = inv_M;
+  return r;
 }
 
 /// ψ, the turn about L over t: M t / J1 + c · bracket, c = −M (J3 − J1)(J2 − J1) /

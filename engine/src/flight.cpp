@@ -1,6 +1,9 @@
+#include <algorithm>
+#include <array>
 #include <atomic>
 
 #include "floor_contact.hpp"
+#include "free_rotation.hpp"
 #include "integrators.hpp"
 #include "pipeline.hpp"
 
@@ -23,6 +26,28 @@ void fly_in_island(Body& b, const SolverBody& solved, double dt) {
   const Vec3 turn = dt * (solved.w + solved.wp);
   if (!turn.isZero()) b.s.R = rotation_from_vector(turn) * b.s.R;
   b.in_contact = true;
+}
+
+// The torque-free turns of the general boxes among lone bodies [begin, end) (at most
+// kLoneGrain) that fly clear of the floor with `exact`, computed together
+// (free_rotation_exact_many: four at a time in SIMD lanes, the same bits as one at a time);
+// given[k − begin] points at body k's, or is null where the body's step computes its own.
+// Measured: 10,000 general boxes' first 0.5 s, ~X → ~Y ns a body-step.
+void turn_general_boxes(StepContext& ctx, std::size_t begin, std::size_t end,
+                        std::array<Mat3, kLoneGrain>& rotated,
+                        std::array<const Mat3*, kLoneGrain>& given) {
+  given.fill(nullptr);
+  if (ctx.world.integrator != Integrator::exact) return;
+  std::array<FreeFlow, kLoneGrain> flows;
+  std::size_t n = 0;
+  for (std::size_t k = begin; k < end; ++k) {
+    const Body& b = ctx.bodies[ctx.scratch.lone_bodies[k]];
+    if (b.c.shape == InertiaShape::isotropic) continue;
+    if (ctx.world.floor && !floor_detail::clear_of_floor(b.s, b.c, ctx.world.floor->height)) continue;
+    flows[n++] = {&b.c.inertia, &b.s.R, &b.s.L, &rotated[k - begin]};
+    given[k - begin] = &rotated[k - begin];
+  }
+  free_rotation_exact_many(std::span(flows.data(), n), ctx.dt);
 }
 
 }  // namespace
@@ -52,23 +77,30 @@ void flight(StepContext& ctx) {
   std::atomic<std::uint32_t> asleep = 0;
   ctx.pool.for_each(s.lone_bodies.size(), kLoneGrain, [&](std::size_t begin, std::size_t end) {
     std::uint32_t impacts = 0, iterations = 0, frozen = 0, slept = 0;
-    for (std::size_t k = begin; k < end; ++k) {
-      const std::uint32_t id = s.lone_bodies[k];
-      Body& b = ctx.bodies[id];
-      const BodyState before = b.s;
-      const FloorStepResult r = advance_with_floor(b, ctx.world, ctx.dt, &s.spins[k]);
-      impacts += static_cast<std::uint32_t>(r.impacts);
-      iterations += static_cast<std::uint32_t>(r.toi_iterations);
-      b.in_contact = r.touched;
-      if (!finalize_body(b, before, renormalize)) {
-        ++frozen;
-        continue;
+    std::array<Mat3, kLoneGrain> rotated;
+    std::array<const Mat3*, kLoneGrain> given;
+    for (std::size_t block = begin; block < end; block += kLoneGrain) {
+      const std::size_t stop = std::min(end, block + kLoneGrain);
+      turn_general_boxes(ctx, block, stop, rotated, given);
+      for (std::size_t k = block; k < stop; ++k) {
+        const std::uint32_t id = s.lone_bodies[k];
+        Body& b = ctx.bodies[id];
+        const BodyState before = b.s;
+        const FloorStepResult r =
+            advance_with_floor(b, ctx.world, ctx.dt, &s.spins[k], given[k - block]);
+        impacts += static_cast<std::uint32_t>(r.impacts);
+        iterations += static_cast<std::uint32_t>(r.toi_iterations);
+        b.in_contact = r.touched;
+        if (!finalize_body(b, before, renormalize)) {
+          ++frozen;
+          continue;
+        }
+        // A body in flight is never still: its timer restarts (settle_lone_body's first rule,
+        // without the call for the 80-90 % of a fall's body-steps that touch nothing).
+        if (b.in_contact) slept += settle_lone_body(b, id, ctx.cache, ctx.dt, ctx.world) ? 1 : 0;
+        else b.still_time = 0.0;
+        note_moved(ctx.broad, id, b.s);
       }
-      // A body in flight is never still: its timer restarts (settle_lone_body's first rule,
-      // without the call for the 80-90 % of a fall's body-steps that touch nothing).
-      if (b.in_contact) slept += settle_lone_body(b, id, ctx.cache, ctx.dt, ctx.world) ? 1 : 0;
-      else b.still_time = 0.0;
-      note_moved(ctx.broad, id, b.s);
     }
     std::atomic_ref(ctx.stats.impacts).fetch_add(impacts, std::memory_order_relaxed);
     std::atomic_ref(ctx.stats.toi_iterations).fetch_add(iterations, std::memory_order_relaxed);

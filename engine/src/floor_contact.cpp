@@ -450,16 +450,17 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
 // Most steps of most bodies are in flight, clear of the floor: that case is one call of the
 // integrator and two comparisons, kept apart from the contact code (whose stack frame and
 // saved registers were a third of the instructions of a cube's flight).
-FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin) {
+FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin,
+                                   const Mat3* rotated) {
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
   if (!w.floor) {
-    s = advance(w.integrator, s, c, w.gravity, dt, spin);
+    s = advance(w.integrator, s, c, w.gravity, dt, spin, rotated);
     return {};
   }
   const double floor_y = w.floor->height;
   if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin);
-  const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin);
+  const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin, rotated);
   if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next, spin);
   s = next;
   return {};

@@ -40,9 +40,11 @@ bool touches_floor_on_edge_or_corner(const BodyState& s, const BodyConstants& c,
 
 /// Advances one awake body by dt: flight with the world's integrator, impacts located by
 /// the world's TOI method and answered with impulses, resting contact without sinking.
-/// `spin` (may be null) keeps a cube's turn between steps (integrators.hpp).
+/// `spin` (may be null) keeps a cube's turn between steps; `rotated` (may be null) is the
+/// body's torque-free attitude after dt, computed beforehand, used when the step is a flight
+/// (integrators.hpp, `advance`).
 FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt,
-                                   SpinCache* spin = nullptr);
+                                   SpinCache* spin = nullptr, const Mat3* rotated = nullptr);
 
 /// Applies simultaneous impulses at the vertices touching the floor (within 1e-9 m of the
 /// lowest) so that no contact approaches: restitution e, Coulomb friction μ. Returns the

@@ -105,16 +105,14 @@ struct JacobiAgm {
 
 // The rotation P(m) (body → a frame whose z axis is m), rows e1 = (m2, −m1, 0)/ρ,
 // e2 = e3 × e1, e3 = m/|m|, ρ = sqrt(m1² + m2²): the Euler-angle frame of Landau & Lifshitz
-// §37 (P = Rx(θ) Rz(ψ_e)), given inv_norm = 1/|m|. Defined while ρ > 0, which the callers
-// guarantee.
-Mat3 momentum_frame(const Vec3& m, double inv_norm) {
-  const double rho2 = m[0] * m[0] + m[1] * m[1];
-  const double inv_rho = 1.0 / std::sqrt(rho2), rho = rho2 * inv_rho;
-  const double z = m[2] * inv_norm * inv_rho;
+// §37 (P = Rx(θ) Rz(ψ_e)), for m = m(t) of the phase f and its scalars (1/|m| = 1/|m0|).
+// Defined while ρ > 0, which the callers guarantee.
+Mat3 momentum_frame(const elliptic::Phase& f) {
+  const double* m = f.m;
   Mat3 p;
-  p.row(0) << m[1] * inv_rho, -m[0] * inv_rho, 0.0;
-  p.row(1) << m[0] * z, m[1] * z, -rho * inv_norm;
-  p.row(2) = m * inv_norm;
+  p.row(0) << m[1] * f.inv_rho, -m[0] * f.inv_rho, 0.0;
+  p.row(1) << m[0] * f.z, m[1] * f.z, -f.rho * f.inv_M;
+  p.row(2) = Vec3(m[0], m[1], m[2]) * f.inv_M;
   return p;
 }
 
@@ -180,14 +178,12 @@ double carlson_rc1(double e) {
 // against Boost's 59 ns for the same arguments (which also checks its domain and sorts them).
 // Relative error measured against Boost in long double: 4e-16 over steps, 1e-15 over
 // arguments from 0 to 100.
-constexpr double kSpreadForSeries = 1.7e-3;  // (2⁻⁵³ / 4)^(1/6)
-
 double carlson_rj(double x, double y, double z, double p) {
   const double a0 = 0.2 * (x + y + z + 2.0 * p);
   const double delta = (p - x) * (p - y) * (p - z);
   const double spread =
       std::max({std::abs(a0 - x), std::abs(a0 - y), std::abs(a0 - z), std::abs(a0 - p)}) *
-      (1.0 / kSpreadForSeries);
+      (1.0 / elliptic::kSpreadForSeries);
   double a = a0, scale = 1.0, sum = 0.0;  // scale = 4⁻ᵐ
   double xm = x, ym = y, zm = z, pm = p;
   for (int m = 0; m < 40 && scale * spread >= a; ++m) {
@@ -295,7 +291,7 @@ Phase phase(const Case& e, double t) {
                                                   : periodic_flow(p, tau, bracket);
   const double M = e.m0.norm();
   const double psi = psi_of(M, t, e.J1, e.J2, e.J3, p.lambda, bracket);
-  Phase out{f.sn, f.cn, f.dn, p.a1, p.a2, p.a3, p.sigma1, p.s, 0.0, 0.0, 1.0 / M};
+  Phase out = frame_scalars(p, f, e.m0[0], e.m0[1], 1.0 / M);
   small_angle_sin_cos(psi, out.sin_psi, out.cos_psi);
   return out;
 }
@@ -312,10 +308,9 @@ Phase phase(const Case& e, double t) {
 // that P(m(t)) continues.
 Mat3 assemble(const Case& e, const Phase& f, const Mat3& R0, const Vec3& L) {
   const Vec3& m0 = e.m0;
-  const double inv_rho = 1.0 / std::sqrt(m0[0] * m0[0] + m0[1] * m0[1]);
   const Vec3 w3 = f.inv_M * L;
-  const Vec3 w1 = inv_rho * ((e.sgn[0] * m0[1]) * R0.col(e.perm[0]) -
-                             (e.sgn[1] * m0[0]) * R0.col(e.perm[1]));
+  const Vec3 w1 = f.inv_rho0 * ((e.sgn[0] * m0[1]) * R0.col(e.perm[0]) -
+                                (e.sgn[1] * m0[0]) * R0.col(e.perm[1]));
   const Vec3 w2 = w3.cross(w1);
   // W Rz(ψ), then its product with P(m(t)).
   Mat3 w;
@@ -324,8 +319,7 @@ Mat3 assemble(const Case& e, const Phase& f, const Mat3& R0, const Vec3& L) {
   w.col(2) = w3;
   // |m(t)| = M up to round-off. Normalising by |m(t)| itself puts a square root and a
   // division more at the end of the chain: 20 ns a call (docs/engine.md, "Tried").
-  const Vec3 m(f.sigma1 * f.a1 * f.cn, f.sigma1 * f.s * f.a2 * f.sn, f.a3 * f.dn);
-  const Mat3 p1 = momentum_frame(m, f.inv_M);
+  const Mat3 p1 = momentum_frame(f);
   Mat3 p1c;  // P(m(t)) C: columns back on the body axes
   for (int i = 0; i < 3; ++i) p1c.col(e.perm[i]) = e.sgn[i] * p1.col(i);
   return w * p1c;

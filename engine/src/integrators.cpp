@@ -110,14 +110,15 @@ const Mat3& cached_turn(const Vec3& angle, SpinCache& spin) {
 }
 
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin) {
+                  const Vec3& gravity, double h, SpinCache* spin, const Mat3* rotated) {
   if (integrator != Integrator::exact && integrator != Integrator::splitting)
     return advance_in_stages(integrator, s, c, gravity, h);
   // Ballistic translation in closed form, x(h) = x + v h + ½ g h², P(h) = P + m g h, and the
   // torque-free rotation; every field written once (no default state built and overwritten:
   // this is the whole step of a body in flight).
   return {s.x + h * (c.inv_mass * s.P) + (0.5 * h * h) * gravity,
-          torque_free(integrator, s, c, h, spin), s.P + (h * c.mass) * gravity, s.L};
+          rotated ? *rotated : torque_free(integrator, s, c, h, spin),
+          s.P + (h * c.mass) * gravity, s.L};
 }
 
 }  // namespace tumble

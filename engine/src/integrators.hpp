@@ -32,8 +32,12 @@ struct SpinCache {
 /// one spin.
 const Mat3& cached_turn(const Vec3& angle, SpinCache& spin);
 
-/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null).
+/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null),
+/// and, for `exact` and `splitting`, the attitude after h taken from `rotated` where it is
+/// given: the torque-free flow from this s over this h, computed beforehand
+/// (free_rotation_exact_many, several bodies at once).
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin = nullptr);
+                  const Vec3& gravity, double h, SpinCache* spin = nullptr,
+                  const Mat3* rotated = nullptr);
 
 }  // namespace tumble

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rotation_series.hpp"
+
 namespace tumble {
 
 Mat3 skew(const Vec3& a) {
@@ -19,11 +21,7 @@ Mat3 skew(const Vec3& a) {
 // above, where it does not cancel.
 void sinc_and_versine(double t, double& a, double& b) {
   if (t < 0.25) {
-    // (−1)ᵏ/(2k+1)! and (−1)ᵏ/(2k+2)!, k = 0…6, in Horner form.
-    a = 1.0 + t * (-1.0 / 6 + t * (1.0 / 120 + t * (-1.0 / 5040 + t * (1.0 / 362880 +
-        t * (-1.0 / 39916800 + t * (1.0 / 6227020800 + t * (-1.0 / 1307674368000.0)))))));
-    b = 0.5 + t * (-1.0 / 24 + t * (1.0 / 720 + t * (-1.0 / 40320 + t * (1.0 / 3628800 +
-        t * (-1.0 / 479001600 + t * (1.0 / 87178291200.0 + t * (-1.0 / 20922789888000.0)))))));
+    sinc_versine_series(t, a, b);
     return;
   }
   const double theta = std::sqrt(t);

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -361,6 +363,58 @@ TEST(FreeRotationSplitting, TumbleCaseAccuracyAndInvariants) {
   const double e2 = splitting_error(c.inertia, c.R0, c.L, 2.0, 400);
   report("tumble_splitting_ratio_h/h2_over_2s", e1 / e2);
   EXPECT_NEAR(e1 / e2, 4.0, 0.4);
+}
+
+// free_rotation_exact_many gives each body the bits free_rotation_exact gives it alone, in
+// every case its lanes meet: general boxes of every aspect (and cubes, symmetric and
+// near-symmetric boxes, which take the closed forms), spins from a hair off a steady spin to
+// fast enough that a lane leaves the short form, near and exactly on the separatrix, no
+// spin, and odd counts (unused lanes). A lane that differs in one bit fails the memcmp.
+TEST(FreeRotationExact, ManyInLanesGiveTheBitsOfOneAtATime) {
+  std::uint64_t seed = 12345;
+  auto uniform = [&seed](double lo, double hi) {  // a fixed 64-bit LCG, the same everywhere
+    seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * static_cast<double>(seed >> 11) * 0x1.0p-53;
+  };
+  struct Body {
+    Vec3 inertia, L;
+    Mat3 R;
+  };
+  std::vector<Body> bodies;
+  for (int i = 0; i < 4000; ++i) {
+    Body b;
+    const Vec3 size(uniform(0.2, 0.6), uniform(0.2, 0.6), uniform(0.2, 0.6));
+    b.inertia = box_inertia(size, uniform(1.0, 10.0));
+    if (i % 50 == 1) b.inertia = box_inertia({0.4, 0.4, 0.4}, 2.0);      // cube
+    if (i % 50 == 2) b.inertia = box_inertia({0.3, 0.3, 0.5}, 2.0);      // symmetric
+    if (i % 50 == 3) b.inertia[1] = b.inertia[0] * (1.0 + 1e-15);        // near-symmetric
+    b.R = some_rotation(uniform(-3.0, 3.0), uniform(-1.5, 1.5), uniform(-3.0, 3.0));
+    // ω up to 3 rad/s, and every 7th body up to 300 rad/s (long increments, ψ past the series).
+    const double w = i % 7 == 0 ? 300.0 : 3.0;
+    Vec3 omega(uniform(-w, w), uniform(-w, w), uniform(-w, w));
+    if (i % 50 == 4) omega = Vec3(1e-9, 2.0, -1e-9);                    // near a steady spin
+    if (i % 50 == 5) omega = Vec3::Zero();                              // no spin
+    b.L = b.R * b.inertia.cwiseProduct(omega);
+    bodies.push_back(b);
+  }
+  // Exactly on the separatrix, both signs of m1 (R = I, so m = L).
+  bodies.push_back({Vec3(1.0, 4.0, 16.0), Vec3(1.0, 0.7, -2.0), Mat3::Identity()});
+  bodies.push_back({Vec3(1.0, 4.0, 16.0), Vec3(-1.0, 0.7, -2.0), Mat3::Identity()});
+  for (double t : {1.0 / 240.0, 1.0 / 60.0, 1.0 / 30.0, 0.7}) {
+    for (std::size_t count : {bodies.size(), std::size_t{3}, std::size_t{2}, std::size_t{1}}) {
+      std::vector<Mat3> got(count);
+      std::vector<FreeFlow> flows;
+      for (std::size_t i = 0; i < count; ++i)
+        flows.push_back({&bodies[i].inertia, &bodies[i].R, &bodies[i].L, &got[i]});
+      free_rotation_exact_many(flows, t);
+      for (std::size_t i = 0; i < count; ++i) {
+        const Body& b = bodies[i];
+        const Mat3 alone = free_rotation_exact(b.inertia, b.R, b.L, t);
+        ASSERT_EQ(std::memcmp(alone.data(), got[i].data(), sizeof(Mat3)), 0)
+            << "body " << i << " of " << count << ", t = " << t;
+      }
+    }
+  }
 }
 
 }  // namespace
