@@ -45,6 +45,22 @@ struct PhaseOf {
 };
 using Phase = PhaseOf<double>;
 
+/// D1 = M² − 2E J1, D2 = M² − 2E J2 and D3 = 2E J3 − M² of body momentum m (canonical
+/// axes) and moments J, each a sum of terms m_i²/J_i (J_k − J_i) of one sign.
+template <class T>
+void differences(T m1, T m2, T m3, T J1, T J2, T J3, T& D1, T& D2, T& D3) {
+  const T q1 = m1 * m1 / J1, q2 = m2 * m2 / J2, q3 = m3 * m3 / J3;
+  D3 = q1 * (J3 - J1) + q2 * (J3 - J2);
+  D1 = q2 * (J2 - J1) + q3 * (J3 - J1);
+  D2 = q1 * (J1 - J2) + q3 * (J3 - J2);
+}
+
+/// Whether the canonical momentum is a steady spin about axis 3 (no polhode to follow).
+template <class T>
+auto steady_about_3(T m1, T m2, T J1, T J3, T D3) {
+  return (D3 / (J3 - J1) <= 0.0) | (m1 * m1 + m2 * m2 == 0.0);
+}
+
 /// The polhode in canonical axes: amplitudes a_i, rate λ (1/s), k², k'², n, s, σ1, and sn,
 /// cn, dn of the start phase u0, read off m0 (m1 = σ1 a1 cn u0, m2 = σ1 s a2 sn u0). On the
 /// separatrix cn = sech > 0, so there σ1 = −1 maps (m1, m2) to (−m1, −m2) when m1 < 0.
@@ -200,11 +216,23 @@ T psi_of(T M, double t, T J1, T J2, T J3, T lambda, T bracket) {
   return M * t / J1 + c * bracket;
 }
 
-/// Reduces the flow of a body with principal moments `inertia` (kg·m²), attitude R and world
-/// momentum L (kg·m²/s) over t (s): returns false with R(t) in `out` where it has a closed
-/// form (no spin, a sphere-like body, regular precession, a steady spin), true with the
-/// elliptic case in `e` otherwise.
-bool reduce(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& out, Case& e);
+/// A body with three distinct moments: its body momentum Rᵀ L (kg·m²/s) and its axes by
+/// increasing moment.
+struct Start {
+  Vec3 mb;
+  std::array<int, 3> sorted;
+};
+
+/// The flow of a body with principal moments `inertia` (kg·m²), attitude R and world momentum
+/// L (kg·m²/s) over t (s), first part: returns false with R(t) in `out` where it has a closed
+/// form (no spin, a sphere-like body, regular precession), true with `st` otherwise.
+bool reduce_start(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& out,
+                  Start& st);
+
+/// Second part: returns false with R(t) in `out` for a steady spin, true with the elliptic
+/// case in `e` otherwise.
+bool reduce_general(const Vec3& inertia, const Mat3& R, const Start& st, double t, Mat3& out,
+                    Case& e);
 
 /// The phase of the elliptic case `e` over t, one body (any t).
 Phase phase(const Case& e, double t);

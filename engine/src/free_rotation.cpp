@@ -325,13 +325,10 @@ Mat3 assemble(const Case& e, const Phase& f, const Mat3& R0, const Vec3& L) {
   return w * p1c;
 }
 
-namespace {
-
-// The general case of `reduce`: canonical axes, and the steady spins that need no elliptic
-// functions.
-bool reduce_general(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
-                    const std::array<int, 3>& sorted, Mat3& out, Case& e) {
-  const Vec3 mb = R.transpose() * L;
+bool reduce_general(const Vec3& inertia, const Mat3& R, const Start& st, double t, Mat3& out,
+                    Case& e) {
+  const Vec3& mb = st.mb;
+  const std::array<int, 3>& sorted = st.sorted;
   const double Ib = inertia[sorted[1]];
   // M² − 2E·I_mid, from the two outer moments only.
   double d_mid = 0.0;
@@ -350,13 +347,9 @@ bool reduce_general(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   std::array<double, 3> sgn{1.0, 1.0, mb[perm[2]] < 0.0 ? -1.0 : 1.0};
   sgn[1] = odd ? -sgn[2] : sgn[2];
   const Vec3 m0(sgn[0] * mb[perm[0]], sgn[1] * mb[perm[1]], sgn[2] * mb[perm[2]]);
-
-  const double q1 = m0[0] * m0[0] / J1, q2 = m0[1] * m0[1] / J2, q3 = m0[2] * m0[2] / J3;
-  const double D3 = q1 * (J3 - J1) + q2 * (J3 - J2);  // 2E J3 − M²
-  const double D1 = q2 * (J2 - J1) + q3 * (J3 - J1);  // M² − 2E J1
-  const double D2 = q1 * (J1 - J2) + q3 * (J3 - J2);  // M² − 2E J2
-
-  if (D3 / (J3 - J1) <= 0.0 || m0[0] * m0[0] + m0[1] * m0[1] == 0.0) {
+  double D1, D2, D3;
+  differences(m0[0], m0[1], m0[2], J1, J2, J3, D1, D2, D3);
+  if (steady_about_3(m0[0], m0[1], J1, J3, D3)) {
     // Steady spin about canonical axis 3, that is sgn[2] times body axis perm[2]: a turn
     // about body axis perm[2] by t mb[perm[2]] / J3 (mb[perm[2]] = sgn[2] m0[2]).
     out = R * axis_rotation(perm[2], t * mb[perm[2]] / J3);
@@ -366,9 +359,8 @@ bool reduce_general(const Vec3& inertia, const Mat3& R, const Vec3& L, double t,
   return true;
 }
 
-}  // namespace
-
-bool reduce(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& out, Case& e) {
+bool reduce_start(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& out,
+                  Start& st) {
   if (L.squaredNorm() == 0.0 || t == 0.0) {
     out = R;
     return false;
@@ -391,7 +383,8 @@ bool reduce(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& o
     out = rotation_from_vector(t * L / i_perp) * R * axis_rotation(k, theta);
     return false;
   }
-  return reduce_general(inertia, R, L, t, sorted, out, e);
+  st = Start{R.transpose() * L, sorted};
+  return true;
 }
 
 }  // namespace elliptic
@@ -399,7 +392,10 @@ bool reduce(const Vec3& inertia, const Mat3& R, const Vec3& L, double t, Mat3& o
 Mat3 free_rotation_exact(const Vec3& inertia, const Mat3& R, const Vec3& L, double t) {
   Mat3 out;
   elliptic::Case e;
-  if (!elliptic::reduce(inertia, R, L, t, out, e)) return out;
+  elliptic::Start st;
+  if (!elliptic::reduce_start(inertia, R, L, t, out, st) ||
+      !elliptic::reduce_general(inertia, R, st, t, out, e))
+    return out;
   return elliptic::assemble(e, elliptic::phase(e, t), R, L);
 }
 

@@ -17,8 +17,6 @@
 #include "lanes.hpp"
 #include "rotation_series.hpp"
 
-#pragma GCC diagnostic ignored "-Wpsabi"  // Lanes never cross a call boundary outside this file
-
 namespace tumble {
 namespace {
 
@@ -138,37 +136,109 @@ void phases(const std::array<const elliptic::Case*, 4>& e, double t,
   }
 }
 
-// R(t) of the n ≤ 4 pending elliptic cases (the unused lanes repeat the first).
-void finish(const std::array<elliptic::Case, 4>& cases,
-            const std::array<const FreeFlow*, 4>& pending, int n, double t) {
-  std::array<const elliptic::Case*, 4> lanes;
-  for (int i = 0; i < 4; ++i) lanes[i] = &cases[i < n ? i : 0];
-  std::array<elliptic::Phase, 4> ph;
-  phases(lanes, t, ph);
-  for (int i = 0; i < n; ++i)
-    *pending[i]->out = elliptic::assemble(cases[i], ph[i], *pending[i]->R, *pending[i]->L);
+// The elliptic cases waiting for their phases, four to a batch.
+class PhaseBatch {
+ public:
+  explicit PhaseBatch(double t) : t_(t) {}
+
+  // Queues flow f's case; runs the batch once it holds four.
+  void add(const elliptic::Case& e, const FreeFlow& f) {
+    cases_[n_] = e;
+    flows_[n_++] = &f;
+    if (n_ == 4) run();
+  }
+
+  // Runs what is queued: a lone case alone, two or three in lanes (the unused ones repeat
+  // the first).
+  void run() {
+    if (n_ == 1) {
+      *flows_[0]->out = elliptic::assemble(cases_[0], elliptic::phase(cases_[0], t_),
+                                           *flows_[0]->R, *flows_[0]->L);
+    } else if (n_ > 1) {
+      std::array<const elliptic::Case*, 4> lanes;
+      for (int i = 0; i < 4; ++i) lanes[i] = &cases_[i < n_ ? i : 0];
+      std::array<elliptic::Phase, 4> ph;
+      phases(lanes, t_, ph);
+      for (int i = 0; i < n_; ++i)
+        *flows_[i]->out = elliptic::assemble(cases_[i], ph[i], *flows_[i]->R, *flows_[i]->L);
+    }
+    n_ = 0;
+  }
+
+ private:
+  double t_;
+  std::array<elliptic::Case, 4> cases_;
+  std::array<const FreeFlow*, 4> flows_;
+  int n_ = 0;
+};
+
+// elliptic::reduce_general for n ≤ 4 started flows, in lanes (the unused ones repeat the
+// first); steady spins, whose R(t) is a plain turn, are reduced alone. Each elliptic case
+// goes to `batch`.
+void reduce_general(const std::array<elliptic::Start, 4>& st,
+                    const std::array<const FreeFlow*, 4>& flows, int n, double t,
+                    PhaseBatch& batch) {
+  Lanes lo, mid, hi, m_lo, m_mid, m_hi, odd_up, odd_down;
+  for (int j = 0; j < 4; ++j) {
+    const int i = j < n ? j : 0;
+    const Vec3& inertia = *flows[i]->inertia;
+    const std::array<int, 3>& a = st[i].sorted;
+    lo[j] = inertia[a[0]];
+    mid[j] = inertia[a[1]];
+    hi[j] = inertia[a[2]];
+    m_lo[j] = st[i].mb[a[0]];
+    m_mid[j] = st[i].mb[a[1]];
+    m_hi[j] = st[i].mb[a[2]];
+    // Whether the canonical permutation is odd, for the sorted axes and for them reversed.
+    odd_up[j] = (a[0] + 1) % 3 != a[1] ? -1.0 : 1.0;
+    odd_down[j] = (a[2] + 1) % 3 != a[1] ? -1.0 : 1.0;
+  }
+  // M² − 2E·I_mid, from the two outer moments only.
+  Lanes d_mid = splat<Lanes>(0.0) + m_lo * m_lo * (lo - mid) / lo;
+  d_mid = d_mid + m_hi * m_hi * (hi - mid) / hi;
+  // Canonical axes: 3 is the largest moment above the separatrix, the smallest below it.
+  const LaneMask up = d_mid >= 0.0;
+  const Lanes J1 = pick(up, lo, hi), J2 = mid, J3 = pick(up, hi, lo);
+  const Lanes m1 = pick(up, m_lo, m_hi), m3 = pick(up, m_hi, m_lo);
+  // Signs: m3 > 0, and axis 2 flipped once more for an odd permutation.
+  const Lanes sgn3 = pick(m3 < 0.0, splat<Lanes>(-1.0), splat<Lanes>(1.0));
+  const Lanes sgn2 = pick(pick(up, odd_up, odd_down) < 0.0, -sgn3, sgn3);
+  const Lanes c1 = 1.0 * m1, c2 = sgn2 * m_mid, c3 = sgn3 * m3;
+  Lanes D1, D2, D3;
+  elliptic::differences(c1, c2, c3, J1, J2, J3, D1, D2, D3);
+  const LaneMask steady = ((m1 == 0.0) & (m3 == 0.0)) | elliptic::steady_about_3(c1, c2, J1, J3, D3);
+  for (int i = 0; i < n; ++i) {
+    const FreeFlow& f = *flows[i];
+    if (steady[i]) {
+      elliptic::Case e;
+      if (elliptic::reduce_general(*f.inertia, *f.R, st[i], t, *f.out, e)) batch.add(e, f);
+      continue;
+    }
+    const std::array<int, 3>& a = st[i].sorted;
+    const std::array<int, 3> perm = up[i] ? a : std::array<int, 3>{a[2], a[1], a[0]};
+    batch.add({Vec3(c1[i], c2[i], c3[i]), J1[i], J2[i], J3[i], D1[i], D2[i], D3[i], perm,
+               {1.0, sgn2[i], sgn3[i]}},
+              f);
+  }
 }
 
 }  // namespace
 
 void free_rotation_exact_many(std::span<const FreeFlow> flows, double t) {
-  std::array<elliptic::Case, 4> cases;
-  std::array<const FreeFlow*, 4> pending;
+  PhaseBatch batch(t);
+  std::array<elliptic::Start, 4> started;
+  std::array<const FreeFlow*, 4> waiting;
   int n = 0;
   for (const FreeFlow& f : flows) {
-    if (!elliptic::reduce(*f.inertia, *f.R, *f.L, t, *f.out, cases[n])) continue;
-    pending[n++] = &f;
+    if (!elliptic::reduce_start(*f.inertia, *f.R, *f.L, t, *f.out, started[n])) continue;
+    waiting[n++] = &f;
     if (n == 4) {
-      finish(cases, pending, n, t);
+      reduce_general(started, waiting, n, t, batch);
       n = 0;
     }
   }
-  if (n == 1) {
-    *pending[0]->out = elliptic::assemble(cases[0], elliptic::phase(cases[0], t), *pending[0]->R,
-                                          *pending[0]->L);
-  } else if (n > 1) {
-    finish(cases, pending, n, t);
-  }
+  if (n > 0) reduce_general(started, waiting, n, t, batch);
+  batch.run();
 }
 
 }  // namespace tumble

@@ -367,9 +367,10 @@ TEST(FreeRotationSplitting, TumbleCaseAccuracyAndInvariants) {
 
 // free_rotation_exact_many gives each body the bits free_rotation_exact gives it alone, in
 // every case its lanes meet: general boxes of every aspect (and cubes, symmetric and
-// near-symmetric boxes, which take the closed forms), spins from a hair off a steady spin to
-// fast enough that a lane leaves the short form, near and exactly on the separatrix, no
-// spin, and odd counts (unused lanes). A lane that differs in one bit fails the memcmp.
+// near-symmetric boxes, which take the closed forms), steady spins about each axis, spins
+// from a hair off a steady spin to fast enough that a lane leaves the short form, near and
+// exactly on the separatrix, no spin, and odd counts (unused lanes). A lane that differs in
+// one bit fails the memcmp.
 TEST(FreeRotationExact, ManyInLanesGiveTheBitsOfOneAtATime) {
   std::uint64_t seed = 12345;
   auto uniform = [&seed](double lo, double hi) {  // a fixed 64-bit LCG, the same everywhere
@@ -394,6 +395,10 @@ TEST(FreeRotationExact, ManyInLanesGiveTheBitsOfOneAtATime) {
     Vec3 omega(uniform(-w, w), uniform(-w, w), uniform(-w, w));
     if (i % 50 == 4) omega = Vec3(1e-9, 2.0, -1e-9);                    // near a steady spin
     if (i % 50 == 5) omega = Vec3::Zero();                              // no spin
+    if (i % 50 >= 6 && i % 50 <= 8) {                                   // steady spins
+      b.R = Mat3::Identity();
+      omega = Vec3::Unit(i % 50 - 6) * uniform(-3.0, 3.0);
+    }
     b.L = b.R * b.inertia.cwiseProduct(omega);
     bodies.push_back(b);
   }
