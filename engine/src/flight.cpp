@@ -43,7 +43,6 @@ void turn_general_boxes(StepContext& ctx, std::size_t begin, std::size_t end,
   for (std::size_t k = begin; k < end; ++k) {
     const Body& b = ctx.bodies[ctx.scratch.lone_bodies[k]];
     if (b.c.shape == InertiaShape::isotropic) continue;
-    if (ctx.world.floor && !floor_detail::clear_of_floor(b.s, b.c, ctx.world.floor->height)) continue;
     flows[n++] = {&b.c.inertia, &b.s.R, &b.s.L, &rotated[k - begin]};
     given[k - begin] = &rotated[k - begin];
   }

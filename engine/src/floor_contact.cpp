@@ -387,7 +387,7 @@ namespace {
 /// advance_with_floor for a body that may meet the floor within the step; `flown`, when not
 /// null, is the state after the whole step's flight from s (already computed by the caller).
 FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyState* flown,
-                           SpinCache* spin) {
+                           SpinCache* spin, const Mat3* rotated = nullptr) {
   FloorStepResult result;
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
@@ -411,7 +411,7 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     }
     // The whole step's flight takes a cube's turn from its spin cache, as in flight.
     const BodyState next = k == 0 && flown ? *flown
-                           : k == 0        ? advance(w.integrator, s, c, w.gravity, remaining, spin)
+                           : k == 0 ? advance(w.integrator, s, c, w.gravity, remaining, spin, rotated)
                                            : advance(w.integrator, s, c, w.gravity, remaining);
     if (clear_of_floor(next, c, floor_y) && (start_clear || w.gravity.y() <= 0.0)) {
       s = next;
@@ -459,7 +459,7 @@ FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, Spi
     return {};
   }
   const double floor_y = w.floor->height;
-  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin);
+  if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin, rotated);
   const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin, rotated);
   if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next, spin);
   s = next;
