@@ -208,6 +208,43 @@ PhaseOf<T> frame_scalars(const Polhode<T>& p, const Jacobi<T>& f, T m1, T m2, T 
   return r;
 }
 
+/// R(t)'s columns before the signed permutation C of assemble: column i of
+/// W Rz(ψ) P(m(t)) with its sign sgn_i, which is R(t)'s column perm_i. W's columns come from
+/// the world momentum L (kg·m²/s), c1 = R0 ê_perm0 and c2 = R0 ê_perm1, and m0's first two
+/// components; col[i][r] is row r of column i.
+template <class T>
+void rotation_columns(const PhaseOf<T>& f, const T (&L)[3], const T (&c1)[3], const T (&c2)[3],
+                      T m01, T m02, const T (&sgn)[3], T (&col)[3][3]) {
+  const T a = sgn[0] * m02, b = sgn[1] * m01;
+  T w1[3], w2[3], w3[3];
+  for (int k = 0; k < 3; ++k) {
+    w3[k] = f.inv_M * L[k];
+    w1[k] = f.inv_rho0 * (a * c1[k] - b * c2[k]);
+  }
+  w2[0] = w3[1] * w1[2] - w3[2] * w1[1];  // w3 × w1
+  w2[1] = w3[2] * w1[0] - w3[0] * w1[2];
+  w2[2] = w3[0] * w1[1] - w3[1] * w1[0];
+  T w[3][3];  // W Rz(ψ), w[c][r]
+  for (int k = 0; k < 3; ++k) {
+    w[0][k] = f.cos_psi * w1[k] + f.sin_psi * w2[k];
+    w[1][k] = f.cos_psi * w2[k] - f.sin_psi * w1[k];
+    w[2][k] = w3[k];
+  }
+  // P(m(t)) by rows (momentum_frame): e1 = (m2, −m1, 0)/ρ, e2 = e3 × e1, e3 = m/|m|.
+  const T* m = f.m;
+  const T p[3][3] = {{m[1] * f.inv_rho, -m[0] * f.inv_rho, splat<T>(0.0)},
+                     {m[0] * f.z, m[1] * f.z, -f.rho * f.inv_M},
+                     {m[0] * f.inv_M, m[1] * f.inv_M, m[2] * f.inv_M}};
+  for (int i = 0; i < 3; ++i) {
+    const T q0 = sgn[i] * p[0][i], q1 = sgn[i] * p[1][i], q2 = sgn[i] * p[2][i];
+    // The sums in the order Eigen 3.4's 3×3 product takes them (its last row starts from
+    // the second term), so that R(t) keeps the bits it had as `w * p1c`.
+    col[i][0] = w[0][0] * q0 + w[1][0] * q1 + w[2][0] * q2;
+    col[i][1] = w[0][1] * q0 + w[1][1] * q1 + w[2][1] * q2;
+    col[i][2] = w[1][2] * q1 + w[2][2] * q2 + w[0][2] * q0;
+  }
+}
+
 /// ψ, the turn about L over t: M t / J1 + c · bracket, c = −M (J3 − J1)(J2 − J1) /
 /// (3 λ J1² (J3 − J2)).
 template <class T>

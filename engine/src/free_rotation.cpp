@@ -103,19 +103,6 @@ struct JacobiAgm {
   }
 };
 
-// The rotation P(m) (body → a frame whose z axis is m), rows e1 = (m2, −m1, 0)/ρ,
-// e2 = e3 × e1, e3 = m/|m|, ρ = sqrt(m1² + m2²): the Euler-angle frame of Landau & Lifshitz
-// §37 (P = Rx(θ) Rz(ψ_e)), for m = m(t) of the phase f and its scalars (1/|m| = 1/|m0|).
-// Defined while ρ > 0, which the callers guarantee.
-Mat3 momentum_frame(const elliptic::Phase& f) {
-  const double* m = f.m;
-  Mat3 p;
-  p.row(0) << m[1] * f.inv_rho, -m[0] * f.inv_rho, 0.0;
-  p.row(1) << m[0] * f.z, m[1] * f.z, -f.rho * f.inv_M;
-  p.row(2) = Vec3(m[0], m[1], m[2]) * f.inv_M;
-  return p;
-}
-
 // Body axes ordered by increasing moment; ties keep the axis order (an insertion sort, stable
 // like std::sort on three elements, without its call overhead).
 std::array<int, 3> axes_by_moment(const Vec3& inertia) {
@@ -307,22 +294,15 @@ Phase phase(const Case& e, double t) {
 // steady spin ρ is round-off small, and only m0's own components give it the direction
 // that P(m(t)) continues.
 Mat3 assemble(const Case& e, const Phase& f, const Mat3& R0, const Vec3& L) {
-  const Vec3& m0 = e.m0;
-  const Vec3 w3 = f.inv_M * L;
-  const Vec3 w1 = f.inv_rho0 * ((e.sgn[0] * m0[1]) * R0.col(e.perm[0]) -
-                                (e.sgn[1] * m0[0]) * R0.col(e.perm[1]));
-  const Vec3 w2 = w3.cross(w1);
-  // W Rz(ψ), then its product with P(m(t)).
-  Mat3 w;
-  w.col(0) = f.cos_psi * w1 + f.sin_psi * w2;
-  w.col(1) = f.cos_psi * w2 - f.sin_psi * w1;
-  w.col(2) = w3;
-  // |m(t)| = M up to round-off. Normalising by |m(t)| itself puts a square root and a
-  // division more at the end of the chain: 20 ns a call (docs/engine.md, "Tried").
-  const Mat3 p1 = momentum_frame(f);
-  Mat3 p1c;  // P(m(t)) C: columns back on the body axes
-  for (int i = 0; i < 3; ++i) p1c.col(e.perm[i]) = e.sgn[i] * p1.col(i);
-  return w * p1c;
+  const double l[3] = {L[0], L[1], L[2]};
+  const double c1[3] = {R0(0, e.perm[0]), R0(1, e.perm[0]), R0(2, e.perm[0])};
+  const double c2[3] = {R0(0, e.perm[1]), R0(1, e.perm[1]), R0(2, e.perm[1])};
+  const double sgn[3] = {e.sgn[0], e.sgn[1], e.sgn[2]};
+  double col[3][3];
+  rotation_columns(f, l, c1, c2, e.m0[0], e.m0[1], sgn, col);
+  Mat3 r;
+  for (int i = 0; i < 3; ++i) r.col(e.perm[i]) = Vec3(col[i][0], col[i][1], col[i][2]);
+  return r;
 }
 
 bool reduce_general(const Vec3& inertia, const Mat3& R, const Start& st, double t, Mat3& out,

@@ -97,9 +97,8 @@ JacobiLanes increment_flow(const elliptic::Polhode<Lanes>& p, Lanes tau, Lanes& 
 }
 
 // elliptic::phase for four cases over t; lanes the short form cannot take are computed
-// alone.
-void phases(const std::array<const elliptic::Case*, 4>& e, double t,
-            std::array<elliptic::Phase, 4>& out) {
+// alone and put back in their lanes.
+elliptic::PhaseOf<Lanes> phases(const std::array<const elliptic::Case*, 4>& e, double t) {
   Lanes m1, m2, J1, J2, J3, D1, D2, D3, M;
   for (int i = 0; i < 4; ++i) {
     const elliptic::Case& c = *e[i];
@@ -124,15 +123,48 @@ void phases(const std::array<const elliptic::Case*, 4>& e, double t,
   fail |= ~(psi2 < 0.25);
   Lanes a, b;
   sinc_versine_series(psi2, a, b);
-  const Lanes sin_psi = a * psi, cos_psi = 1.0 - b * (psi * psi);
-  const elliptic::PhaseOf<Lanes> r = elliptic::frame_scalars(p, f, m1, m2, 1.0 / M);
+  elliptic::PhaseOf<Lanes> r = elliptic::frame_scalars(p, f, m1, m2, 1.0 / M);
+  r.sin_psi = a * psi;
+  r.cos_psi = 1.0 - b * (psi * psi);
   for (int i = 0; i < 4; ++i) {
-    if (fail[i]) {
-      out[i] = elliptic::phase(*e[i], t);
-      continue;
+    if (!fail[i]) continue;
+    const elliptic::Phase alone = elliptic::phase(*e[i], t);
+    for (int k = 0; k < 3; ++k) r.m[k][i] = alone.m[k];
+    r.inv_rho[i] = alone.inv_rho;
+    r.rho[i] = alone.rho;
+    r.z[i] = alone.z;
+    r.inv_rho0[i] = alone.inv_rho0;
+    r.cos_psi[i] = alone.cos_psi;
+    r.sin_psi[i] = alone.sin_psi;
+    r.inv_M[i] = alone.inv_M;
+  }
+  return r;
+}
+
+// R(t) of four cases from their phases (elliptic::assemble in lanes): each lane's columns
+// go to the places its permutation gives them.
+void assemble(const std::array<const elliptic::Case*, 4>& e,
+              const std::array<const FreeFlow*, 4>& flows, int n,
+              const elliptic::PhaseOf<Lanes>& f) {
+  Lanes L[3], c1[3], c2[3], sgn[3], m01, m02;
+  for (int i = 0; i < 4; ++i) {
+    const elliptic::Case& c = *e[i];
+    const Mat3& R0 = *flows[i]->R;
+    for (int k = 0; k < 3; ++k) {
+      L[k][i] = (*flows[i]->L)[k];
+      c1[k][i] = R0(k, c.perm[0]);
+      c2[k][i] = R0(k, c.perm[1]);
+      sgn[k][i] = c.sgn[k];
     }
-    out[i] = {{r.m[0][i], r.m[1][i], r.m[2][i]}, r.inv_rho[i], r.rho[i], r.z[i], r.inv_rho0[i],
-              cos_psi[i], sin_psi[i], r.inv_M[i]};
+    m01[i] = c.m0[0];
+    m02[i] = c.m0[1];
+  }
+  Lanes col[3][3];
+  elliptic::rotation_columns(f, L, c1, c2, m01, m02, sgn, col);
+  for (int i = 0; i < n; ++i) {
+    Mat3& out = *flows[i]->out;
+    for (int k = 0; k < 3; ++k)
+      out.col(e[i]->perm[k]) = Vec3(col[k][0][i], col[k][1][i], col[k][2][i]);
   }
 }
 
@@ -156,11 +188,12 @@ class PhaseBatch {
                                            *flows_[0]->R, *flows_[0]->L);
     } else if (n_ > 1) {
       std::array<const elliptic::Case*, 4> lanes;
-      for (int i = 0; i < 4; ++i) lanes[i] = &cases_[i < n_ ? i : 0];
-      std::array<elliptic::Phase, 4> ph;
-      phases(lanes, t_, ph);
-      for (int i = 0; i < n_; ++i)
-        *flows_[i]->out = elliptic::assemble(cases_[i], ph[i], *flows_[i]->R, *flows_[i]->L);
+      std::array<const FreeFlow*, 4> flows;
+      for (int i = 0; i < 4; ++i) {
+        lanes[i] = &cases_[i < n_ ? i : 0];
+        flows[i] = flows_[i < n_ ? i : 0];
+      }
+      assemble(lanes, flows, n_, phases(lanes, t_));
     }
     n_ = 0;
   }
