@@ -48,7 +48,8 @@ using Phase = PhaseOf<double>;
 /// D1 = M² − 2E J1, D2 = M² − 2E J2 and D3 = 2E J3 − M² of body momentum m (canonical
 /// axes) and moments J, each a sum of terms m_i²/J_i (J_k − J_i) of one sign.
 template <class T>
-void differences(T m1, T m2, T m3, T J1, T J2, T J3, T& D1, T& D2, T& D3) {
+[[gnu::always_inline]] inline void differences(T m1, T m2, T m3, T J1, T J2, T J3, T& D1, T& D2,
+                                               T& D3) {
   const T q1 = m1 * m1 / J1, q2 = m2 * m2 / J2, q3 = m3 * m3 / J3;
   D3 = q1 * (J3 - J1) + q2 * (J3 - J2);
   D1 = q2 * (J2 - J1) + q3 * (J3 - J1);
@@ -57,7 +58,7 @@ void differences(T m1, T m2, T m3, T J1, T J2, T J3, T& D1, T& D2, T& D3) {
 
 /// Whether the canonical momentum is a steady spin about axis 3 (no polhode to follow).
 template <class T>
-auto steady_about_3(T m1, T m2, T J1, T J3, T D3) {
+[[gnu::always_inline]] inline auto steady_about_3(T m1, T m2, T J1, T J3, T D3) {
   return (D3 / (J3 - J1) <= 0.0) | (m1 * m1 + m2 * m2 == 0.0);
 }
 
@@ -71,7 +72,8 @@ struct Polhode {
 };
 
 template <class T>
-Polhode<T> make_polhode(T m1, T m2, T J1, T J2, T J3, T D1, T D2, T D3) {
+[[gnu::always_inline]] inline Polhode<T> make_polhode(T m1, T m2, T J1, T J2, T J3, T D1, T D2,
+                                                      T D3) {
   Polhode<T> p;
   const T r31 = 1.0 / (J3 - J1), r32 = 1.0 / (J3 - J2), r32d1 = r32 / D1;
   p.a1 = root(J1 * D3 * r31);
@@ -97,7 +99,7 @@ Polhode<T> make_polhode(T m1, T m2, T J1, T J2, T J3, T D1, T D2, T D3) {
 /// coefficients checked against mpmath's Taylor coefficients): the first omitted term is below
 /// 0.011 |u|¹⁰ ≈ 1e-17.
 template <class T>
-Jacobi<T> jacobi_series(T u, T k2) {
+[[gnu::always_inline]] inline Jacobi<T> jacobi_series(T u, T k2) {
   constexpr double f3 = 1.0 / 6.0, f4 = 1.0 / 24.0, f5 = 1.0 / 120.0, f6 = 1.0 / 720.0,
                    f7 = 1.0 / 5040.0, f8 = 1.0 / 40320.0, f9 = 1.0 / 362880.0;  // 1/j!
   const T u2 = u * u, k4 = k2 * k2, k6 = k4 * k2;
@@ -119,7 +121,7 @@ Jacobi<T> jacobi_series(T u, T k2) {
 /// sn, cn, dn at 2u from those at u: sn 2u = 2 s c d / (1 − k² s⁴),
 /// cn 2u = (c² − s² d²) / (1 − k² s⁴), dn 2u = (d² − k² s² c²) / (1 − k² s⁴) (DLMF 22.8.1–3).
 template <class T>
-Jacobi<T> jacobi_doubled(const Jacobi<T>& f, T k2) {
+[[gnu::always_inline]] inline Jacobi<T> jacobi_doubled(const Jacobi<T>& f, T k2) {
   const T s2 = f.sn * f.sn, c2 = f.cn * f.cn, d2 = f.dn * f.dn;
   const T inv = 1.0 / (1.0 - k2 * s2 * s2);
   return {2.0 * f.sn * f.cn * f.dn * inv, (c2 - s2 * d2) * inv, (d2 - k2 * s2 * c2) * inv};
@@ -129,7 +131,8 @@ Jacobi<T> jacobi_doubled(const Jacobi<T>& f, T k2) {
 /// (DLMF 22.8.1–2; dn from cn and sn, dn² = cn² + k'² sn², not the third addition formula:
 /// this puts m(t) on the energy surface with M² − 2E J2 exact to relative round-off).
 template <class T>
-Jacobi<T> jacobi_added(const Polhode<T>& p, const Jacobi<T>& f1, T& s01) {
+[[gnu::always_inline]] inline Jacobi<T> jacobi_added(const Polhode<T>& p, const Jacobi<T>& f1,
+                                                     T& s01) {
   const Jacobi<T>& f0 = p.start;
   s01 = f0.sn * f1.sn;
   const T inv = 1.0 / (1.0 - p.k2 * s01 * s01);
@@ -147,7 +150,7 @@ inline constexpr double kSpreadForSeries = 1.7e-3;
 /// Carlson's R_C(1, 1 + e) by its alternating series Σ (−e)ʲ/(2j + 1) to e⁵, exact to
 /// round-off for |e| < 1e-3 (the first omitted term is below e⁶/13).
 template <class T>
-T rc1_series(T e) {
+[[gnu::always_inline]] inline T rc1_series(T e) {
   constexpr double c3 = 1.0 / 3.0, c5 = 1.0 / 5.0, c7 = 1.0 / 7.0, c9 = 1.0 / 9.0,
                    c11 = 1.0 / 11.0;
   return 1.0 + e * (-c3 + e * (c5 + e * (-c7 + e * (c9 - e * c11))));
@@ -156,7 +159,7 @@ T rc1_series(T e) {
 /// One duplication of Carlson's R_J (x, y, z, p ← (· + λ)/4): returns λ and, in d,
 /// (√p + √x)(√p + √y)(√p + √z).
 template <class T>
-T rj_duplication(T x, T y, T z, T p, T& d) {
+[[gnu::always_inline]] inline T rj_duplication(T x, T y, T z, T p, T& d) {
   const T sx = root(x), sy = root(y), sz = root(z), sp = root(p);
   d = (sp + sx) * (sp + sy) * (sp + sz);
   return sx * sy + sx * sz + sy * sz;
@@ -165,7 +168,7 @@ T rj_duplication(T x, T y, T z, T p, T& d) {
 /// R_J's end: the fifth-order Taylor polynomial about the mean a of the duplicated arguments
 /// (Carlson, Numer. Algorithms 10, 1995), plus 6 Σ of the duplications' R_C terms.
 template <class T>
-T rj_tail(T x, T y, T z, T a0, T a, T scale, T sum) {
+[[gnu::always_inline]] inline T rj_tail(T x, T y, T z, T a0, T a, T scale, T sum) {
   const T inv = scale / a;
   const T X = (a0 - x) * inv, Y = (a0 - y) * inv, Z = (a0 - z) * inv;
   const T P = -0.5 * (X + Y + Z);
@@ -183,7 +186,7 @@ T rj_tail(T x, T y, T z, T a0, T a, T scale, T sum) {
 /// The increment's terms of the bracket (3/n)[Π(u) − u] over [u0, u0 + τ] (increment_flow in
 /// free_rotation.cpp): w and z of the addition theorem of Π, and (f1.sn³ R_J, its first term).
 template <class T>
-T bracket_z(const Polhode<T>& p, const Jacobi<T>& f, T s01, T& w) {
+[[gnu::always_inline]] inline T bracket_z(const Polhode<T>& p, const Jacobi<T>& f, T s01, T& w) {
   const T X = s01 * f.sn;
   const T A = 1.0 - p.n * (f.sn * f.sn - s01 * f.cn * f.dn);
   w = root(-p.n * (p.k2 - p.n) * (1.0 - p.n));
@@ -194,7 +197,8 @@ T bracket_z(const Polhode<T>& p, const Jacobi<T>& f, T s01, T& w) {
 /// m(t) = (σ1 a1 cn, σ1 s a2 sn, a3 dn) from sn, cn, dn at u0 + τ, its 1/ρ, ρ and z, and 1/ρ
 /// of m0 = (m1, m2, ·). cos ψ, sin ψ are left to the caller.
 template <class T>
-PhaseOf<T> frame_scalars(const Polhode<T>& p, const Jacobi<T>& f, T m1, T m2, T inv_M) {
+[[gnu::always_inline]] inline PhaseOf<T> frame_scalars(const Polhode<T>& p, const Jacobi<T>& f,
+                                                       T m1, T m2, T inv_M) {
   PhaseOf<T> r;
   r.m[0] = p.sigma1 * p.a1 * f.cn;
   r.m[1] = p.sigma1 * p.s * p.a2 * f.sn;
@@ -213,8 +217,9 @@ PhaseOf<T> frame_scalars(const Polhode<T>& p, const Jacobi<T>& f, T m1, T m2, T 
 /// the world momentum L (kg·m²/s), c1 = R0 ê_perm0 and c2 = R0 ê_perm1, and m0's first two
 /// components; col[i][r] is row r of column i.
 template <class T>
-void rotation_columns(const PhaseOf<T>& f, const T (&L)[3], const T (&c1)[3], const T (&c2)[3],
-                      T m01, T m02, const T (&sgn)[3], T (&col)[3][3]) {
+[[gnu::always_inline]] inline void rotation_columns(const PhaseOf<T>& f, const T (&L)[3],
+                                                    const T (&c1)[3], const T (&c2)[3], T m01,
+                                                    T m02, const T (&sgn)[3], T (&col)[3][3]) {
   const T a = sgn[0] * m02, b = sgn[1] * m01;
   T w1[3], w2[3], w3[3];
   for (int k = 0; k < 3; ++k) {
@@ -248,7 +253,7 @@ void rotation_columns(const PhaseOf<T>& f, const T (&L)[3], const T (&c1)[3], co
 /// ψ, the turn about L over t: M t / J1 + c · bracket, c = −M (J3 − J1)(J2 − J1) /
 /// (3 λ J1² (J3 − J2)).
 template <class T>
-T psi_of(T M, double t, T J1, T J2, T J3, T lambda, T bracket) {
+[[gnu::always_inline]] inline T psi_of(T M, double t, T J1, T J2, T J3, T lambda, T bracket) {
   const T c = -M * (J3 - J1) * (J2 - J1) / (3.0 * lambda * J1 * J1 * (J3 - J2));
   return M * t / J1 + c * bracket;
 }

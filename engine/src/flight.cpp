@@ -4,6 +4,7 @@
 
 #include "floor_contact.hpp"
 #include "free_rotation.hpp"
+#include "lanes.hpp"
 #include "integrators.hpp"
 #include "pipeline.hpp"
 
@@ -40,7 +41,7 @@ void turn_general_boxes(StepContext& ctx, std::size_t begin, std::size_t end,
                         std::array<Mat3, kLoneGrain>& rotated,
                         std::array<const Mat3*, kLoneGrain>& given) {
   given.fill(nullptr);
-  if (ctx.world.integrator != Integrator::exact) return;
+  if (!kLanesInOneRegister || ctx.world.integrator != Integrator::exact) return;
   std::array<FreeFlow, kLoneGrain> flows;
   std::size_t n = 0;
   for (std::size_t k = begin; k < end; ++k) {

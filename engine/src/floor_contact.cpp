@@ -385,7 +385,8 @@ bool touches_floor_on_edge_or_corner(const BodyState& s, const BodyConstants& c,
 namespace {
 
 /// advance_with_floor for a body that may meet the floor within the step; `flown`, when not
-/// null, is the state after the whole step's flight from s (already computed by the caller).
+/// null, is the state after the whole step's flight from s (already computed by the caller),
+/// and `rotated`, when not null, the attitude after it (flight's batched turns).
 FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyState* flown,
                            SpinCache* spin, const Mat3* rotated = nullptr) {
   FloorStepResult result;
@@ -409,10 +410,12 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
       result.touched = true;
       return result;
     }
-    // The whole step's flight takes a cube's turn from its spin cache, as in flight.
-    const BodyState next = k == 0 && flown ? *flown
-                           : k == 0 ? advance(w.integrator, s, c, w.gravity, remaining, spin, rotated)
-                                           : advance(w.integrator, s, c, w.gravity, remaining);
+    // The whole step's flight takes a cube's turn from its spin cache, as in flight, and a
+    // general box's from the turns flight computed together.
+    const BodyState next =
+        k == 0 && flown ? *flown
+        : k == 0        ? advance(w.integrator, s, c, w.gravity, remaining, spin, rotated)
+                        : advance(w.integrator, s, c, w.gravity, remaining);
     if (clear_of_floor(next, c, floor_y) && (start_clear || w.gravity.y() <= 0.0)) {
       s = next;
       return result;

@@ -239,7 +239,8 @@ void reduce_general(const std::array<elliptic::Start, 4>& st,
   const Lanes c1 = 1.0 * m1, c2 = sgn2 * m_mid, c3 = sgn3 * m3;
   Lanes D1, D2, D3;
   elliptic::differences(c1, c2, c3, J1, J2, J3, D1, D2, D3);
-  const LaneMask steady = ((m1 == 0.0) & (m3 == 0.0)) | elliptic::steady_about_3(c1, c2, J1, J3, D3);
+  const LaneMask steady =
+      ((m1 == 0.0) & (m3 == 0.0)) | elliptic::steady_about_3(c1, c2, J1, J3, D3);
   for (int i = 0; i < n; ++i) {
     const FreeFlow& f = *flows[i];
     if (steady[i]) {

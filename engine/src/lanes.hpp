@@ -14,6 +14,15 @@
 
 namespace tumble {
 
+/// Whether four lanes are one register (AVX). Without it each operation on Lanes is two SSE2
+/// instructions and the lanes buy nothing: 10,000 general boxes over 2 s took 1.10× the time
+/// batched in an SSE2 build, against 0.87× with AVX.
+#if defined(__AVX__)
+inline constexpr bool kLanesInOneRegister = true;
+#else
+inline constexpr bool kLanesInOneRegister = false;
+#endif
+
 /// Four doubles, one per lane.
 using Lanes = double __attribute__((vector_size(32)));
 /// A lane mask: all bits set where a comparison of Lanes holds, zero where not.

@@ -8,7 +8,7 @@ namespace tumble {
 /// a = sin θ/θ and b = (1 − cos θ)/θ² from t = θ² < 0.25, by their Taylor series in θ² to θ¹²
 /// ((−1)ᵏ/(2k+1)! and (−1)ᵏ/(2k+2)!, k = 0…6, in Horner form): math.cpp says why.
 template <class T>
-void sinc_versine_series(T t, T& a, T& b) {
+[[gnu::always_inline]] inline void sinc_versine_series(T t, T& a, T& b) {
   a = 1.0 + t * (-1.0 / 6 + t * (1.0 / 120 + t * (-1.0 / 5040 + t * (1.0 / 362880 +
       t * (-1.0 / 39916800 + t * (1.0 / 6227020800 + t * (-1.0 / 1307674368000.0)))))));
   b = 0.5 + t * (-1.0 / 24 + t * (1.0 / 720 + t * (-1.0 / 40320 + t * (1.0 / 3628800 +
