@@ -2,7 +2,7 @@
 /// The general box's torque-free flow (free_rotation.cpp explains it) cut where one body at a
 /// time and four in SIMD lanes (free_rotation_lanes.cpp) meet: the reduction to the elliptic
 /// case, the phase along the polhode (Jacobi sn, cn, dn and the angle ψ about L), and the
-/// rotation assembled from them. The phase's formulas are templates over double and Lanes,
+/// rotation assembled from them. Their formulas are templates over double and Lanes,
 /// written once, so that each lane rounds as the scalar does: the same bits either way.
 /// Internal to the engine; pure functions, thread-safe.
 #include <array>

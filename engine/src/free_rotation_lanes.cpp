@@ -1,5 +1,6 @@
-/// free_rotation_exact for many bodies at once: the general boxes' elliptic phases four at a
-/// time, one per SIMD lane (lanes.hpp), each lane with the scalar's bits.
+/// free_rotation_exact for many bodies at once: the general boxes' elliptic flows (the
+/// reduction to the elliptic case, the phase, the rotation) four at a time, one per SIMD lane
+/// (lanes.hpp), each lane with the scalar's bits.
 ///
 /// Why: a general box's exact step is a chain of about twenty square roots and divisions
 /// (the polhode's amplitudes and rate, the Jacobi functions' doublings, Carlson's R_J), each
@@ -9,7 +10,8 @@
 /// code operation for operation (the formulas are elliptic_flow.hpp's templates; each loop
 /// runs a lane as often as the scalar would run it), so a body gets the same bits in a lane
 /// as alone. A lane that would leave the short form (an increment longer than
-/// kMaxIncrement, an argument outside a series' range) is computed again alone.
+/// kMaxIncrement, an argument outside a series' range) or is a steady spin is computed again
+/// alone.
 #include <array>
 
 #include "elliptic_flow.hpp"

@@ -16,7 +16,7 @@ namespace tumble {
 
 /// Whether four lanes are one register (AVX). Without it each operation on Lanes is two SSE2
 /// instructions and the lanes buy nothing: 10,000 general boxes over 2 s took 1.10× the time
-/// batched in an SSE2 build, against 0.87× with AVX.
+/// batched in an SSE2 build, against 0.79× with AVX.
 #if defined(__AVX__)
 inline constexpr bool kLanesInOneRegister = true;
 #else
