@@ -414,8 +414,9 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
     // general box's from the turns flight computed together.
     const BodyState next =
         k == 0 && flown ? *flown
-        : k == 0        ? advance(w.integrator, s, c, w.gravity, remaining, spin, rotated)
-                        : advance(w.integrator, s, c, w.gravity, remaining);
+        : k == 0 && rotated ? advance_turned(s, c, w.gravity, remaining, *rotated)
+        : k == 0            ? advance(w.integrator, s, c, w.gravity, remaining, spin)
+                            : advance(w.integrator, s, c, w.gravity, remaining);
     if (clear_of_floor(next, c, floor_y) && (start_clear || w.gravity.y() <= 0.0)) {
       s = next;
       return result;
@@ -448,25 +449,40 @@ FloorStepResult meet_floor(Body& body, const WorldDef& w, double dt, const BodyS
   return result;
 }
 
-}  // namespace
-
 // Most steps of most bodies are in flight, clear of the floor: that case is one call of the
 // integrator and two comparisons, kept apart from the contact code (whose stack frame and
-// saved registers were a third of the instructions of a cube's flight).
-FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin,
-                                   const Mat3* rotated) {
+// saved registers were a third of the instructions of a cube's flight). `fly` gives the whole
+// step's flight from the body's state; `rotated` is what meet_floor takes for its own.
+template <class Fly>
+FloorStepResult step_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin,
+                                const Mat3* rotated, const Fly& fly) {
   BodyState& s = body.s;
   const BodyConstants& c = body.c;
   if (!w.floor) {
-    s = advance(w.integrator, s, c, w.gravity, dt, spin, rotated);
+    s = fly(s);
     return {};
   }
   const double floor_y = w.floor->height;
   if (!clear_of_floor(s, c, floor_y)) return meet_floor(body, w, dt, nullptr, spin, rotated);
-  const BodyState next = advance(w.integrator, s, c, w.gravity, dt, spin, rotated);
+  const BodyState next = fly(s);
   if (!clear_of_floor(next, c, floor_y)) return meet_floor(body, w, dt, &next, spin);
   s = next;
   return {};
+}
+
+}  // namespace
+
+FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin) {
+  return step_with_floor(body, w, dt, spin, nullptr, [&](const BodyState& s) {
+    return advance(w.integrator, s, body.c, w.gravity, dt, spin);
+  });
+}
+
+FloorStepResult advance_with_floor(Body& body, const WorldDef& w, double dt, SpinCache* spin,
+                                   const Mat3& rotated) {
+  return step_with_floor(body, w, dt, spin, &rotated, [&](const BodyState& s) {
+    return advance_turned(s, body.c, w.gravity, dt, rotated);
+  });
 }
 
 }  // namespace tumble

@@ -40,11 +40,15 @@ bool touches_floor_on_edge_or_corner(const BodyState& s, const BodyConstants& c,
 
 /// Advances one awake body by dt: flight with the world's integrator, impacts located by
 /// the world's TOI method and answered with impulses, resting contact without sinking.
-/// `spin` (may be null) keeps a cube's turn between steps; `rotated` (may be null) is the
-/// body's torque-free attitude after dt, computed beforehand, used when the step is a flight
-/// (integrators.hpp, `advance`).
+/// `spin` (may be null) keeps a cube's turn between steps (integrators.hpp).
 FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt,
-                                   SpinCache* spin = nullptr, const Mat3* rotated = nullptr);
+                                   SpinCache* spin = nullptr);
+
+/// The same for a body under `exact` whose torque-free attitude after dt, `rotated`, was
+/// computed beforehand (free_rotation_exact_many): its flights over the whole step take it
+/// (integrators.hpp, `advance_turned`). The same bits as without it.
+FloorStepResult advance_with_floor(Body& body, const WorldDef& world, double dt,
+                                   SpinCache* spin, const Mat3& rotated);
 
 /// Applies simultaneous impulses at the vertices touching the floor (within 1e-9 m of the
 /// lowest) so that no contact approaches: restitution e, Coulomb friction μ. Returns the

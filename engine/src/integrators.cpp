@@ -109,16 +109,31 @@ const Mat3& cached_turn(const Vec3& angle, SpinCache& spin) {
   return spin.turn;
 }
 
+namespace {
+
+// Ballistic translation in closed form, x(h) = x + v h + ½ g h² and P(h) = P + m g h. With
+// the attitude after h, this is the whole step of a body in flight; the state is built with
+// every field written once (no default state built and overwritten).
+Vec3 ballistic_x(const BodyState& s, const BodyConstants& c, const Vec3& gravity, double h) {
+  return s.x + h * (c.inv_mass * s.P) + (0.5 * h * h) * gravity;
+}
+Vec3 ballistic_P(const BodyState& s, const BodyConstants& c, const Vec3& gravity, double h) {
+  return s.P + (h * c.mass) * gravity;
+}
+
+}  // namespace
+
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin, const Mat3* rotated) {
+                  const Vec3& gravity, double h, SpinCache* spin) {
   if (integrator != Integrator::exact && integrator != Integrator::splitting)
     return advance_in_stages(integrator, s, c, gravity, h);
-  // Ballistic translation in closed form, x(h) = x + v h + ½ g h², P(h) = P + m g h, and the
-  // torque-free rotation; every field written once (no default state built and overwritten:
-  // this is the whole step of a body in flight).
-  return {s.x + h * (c.inv_mass * s.P) + (0.5 * h * h) * gravity,
-          rotated ? *rotated : torque_free(integrator, s, c, h, spin),
-          s.P + (h * c.mass) * gravity, s.L};
+  return {ballistic_x(s, c, gravity, h), torque_free(integrator, s, c, h, spin),
+          ballistic_P(s, c, gravity, h), s.L};
+}
+
+BodyState advance_turned(const BodyState& s, const BodyConstants& c, const Vec3& gravity,
+                         double h, const Mat3& rotated) {
+  return {ballistic_x(s, c, gravity, h), rotated, ballistic_P(s, c, gravity, h), s.L};
 }
 
 }  // namespace tumble

@@ -32,12 +32,14 @@ struct SpinCache {
 /// one spin.
 const Mat3& cached_turn(const Vec3& angle, SpinCache& spin);
 
-/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null),
-/// and, for `exact` and `splitting`, the attitude after h taken from `rotated` where it is
-/// given: the torque-free flow from this s over this h, computed beforehand
-/// (free_rotation_exact_many, several bodies at once).
+/// `advance` with a cube's turn taken from `spin` when it holds this step's (spin may be null).
 BodyState advance(Integrator integrator, const BodyState& s, const BodyConstants& c,
-                  const Vec3& gravity, double h, SpinCache* spin = nullptr,
-                  const Mat3* rotated = nullptr);
+                  const Vec3& gravity, double h, SpinCache* spin = nullptr);
+
+/// `advance` of `exact` or `splitting` given the attitude after h, `rotated`: the torque-free
+/// flow from this s over this h, computed beforehand (free_rotation_exact_many, several bodies
+/// at once). The same bits as `advance` when `rotated` has them.
+BodyState advance_turned(const BodyState& s, const BodyConstants& c, const Vec3& gravity,
+                         double h, const Mat3& rotated);
 
 }  // namespace tumble

@@ -153,6 +153,7 @@ struct StepContext {
   StepStats& stats;          ///< This step's counters.
   WorkerPool& pool;          ///< Threads for the stages' independent work (1: inline).
   bool timed = false;        ///< The World times its stages (and the contact solve's passes).
+  bool unequal_moments = true;  ///< Some body is not a cube (flight may turn bodies in lanes).
 };
 
 /// Sizes the cache for `body_count` bodies, each alone (not in a sleeping island); called

@@ -44,6 +44,7 @@ World::World(Scene scene) : scene_(std::move(scene)) {
     // starts asleep: it costs nothing from the first step instead of after the sleep timer.
     if (w.floor && rests_on_face(b.s, b.c, w.floor->height, w.gravity))
       b.activity = Activity::asleep;
+    if (b.c.shape != InertiaShape::isotropic) ++unequal_moments_;
     bodies_.push_back(b);
   }
   // A scene that packs its bodies into one another costs memory and time quadratic in their
@@ -77,6 +78,7 @@ World::World(const World& other)
       time_(other.time_),
       steps_(other.steps_),
       total_impacts_(other.total_impacts_),
+      unequal_moments_(other.unequal_moments_),
       last_(other.last_),
       time_stages_(other.time_stages_),
       cache_(std::make_unique<ContactCache>(*other.cache_)),
@@ -99,8 +101,9 @@ void World::step() { step(scene_.world.dt); }
 void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0)) throw InvalidInput("dt must be finite and > 0");
   last_ = {};
-  StepContext ctx{scene_.world, dt,       steps_, bodies_, *cache_,
-                  *broad_,       *scratch_, last_,  *pool_,  time_stages_};
+  StepContext ctx{scene_.world, dt,        steps_, bodies_, *cache_,
+                  *broad_,       *scratch_,  last_,  *pool_,  time_stages_,
+                  unequal_moments_ > 0};
   const WorkerPool::Busy busy(*pool_);  // workers poll through the step's serial stretches
   for (int round = 0; round < kMaxWakeRounds; ++round) {
     run_stage(Stage::broad_phase, broad_phase, ctx, time_stages_);
@@ -131,6 +134,7 @@ BodyId World::add_body(const BodyDef& def) {
                             w.floor ? w.floor->friction : 0.0);
   b.s = make_body_state(def, b.c);
   const auto id = static_cast<BodyId>(bodies_.size());
+  if (b.c.shape != InertiaShape::isotropic) ++unequal_moments_;
   bodies_.push_back(b);
   scene_.bodies.push_back(def);
   init_caches(*cache_, bodies_.size());  // an island of its own

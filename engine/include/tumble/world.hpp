@@ -140,6 +140,7 @@ class World {
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
   std::uint64_t total_impacts_ = 0;
+  std::size_t unequal_moments_ = 0;  // bodies that are not cubes (whose flight may use lanes)
   StepStats last_;
   bool time_stages_ = false;
   std::unique_ptr<ContactCache> cache_;       // warm-start contacts, sleeping islands
