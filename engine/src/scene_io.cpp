@@ -67,7 +67,7 @@ BodyDef body_from_json(const json& j, const std::string& at) {
 Scene scene_from_json(const json& j) {
   if (!j.is_object()) fail("", "a scene must be a JSON object");
   refuse_unknown_keys(j, "", {"name", "gravity", "floor", "dt", "integrator", "toi",
-                              "toi_tolerance", "bodies", "description"});
+                              "toi_tolerance", "max_overlap", "bodies", "description"});
   Scene scene;
   WorldDef& w = scene.world;
   if (j.contains("name")) w.name = text(j["name"], "name");
@@ -101,6 +101,7 @@ Scene scene_from_json(const json& j) {
     w.toi = *m;
   }
   if (j.contains("toi_tolerance")) w.toi_tolerance = number(j["toi_tolerance"], "toi_tolerance");
+  if (j.contains("max_overlap")) w.max_overlap = number(j["max_overlap"], "max_overlap");
   if (!j.contains("bodies") || !j["bodies"].is_array()) fail("bodies", "must be an array");
   const json& bodies = j["bodies"];
   if (bodies.size() > kMaxBodies)
@@ -127,6 +128,7 @@ json scene_to_json(const Scene& scene) {
   j["integrator"] = std::string(to_string(w.integrator));
   j["toi"] = std::string(to_string(w.toi));
   j["toi_tolerance"] = w.toi_tolerance;
+  if (w.max_overlap > 0.0) j["max_overlap"] = w.max_overlap;
   json bodies = json::array();
   for (const BodyDef& b : scene.bodies) {
     json jb{{"name", b.name},

@@ -1,13 +1,30 @@
 #include "tumble/world.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "floor_contact.hpp"
+#include "overlap_bound.hpp"
 #include "pipeline.hpp"
 
 namespace tumble {
+
+/// The state a pass can change, kept to take it again: one per halving level.
+struct PassSnapshot {
+  std::vector<Body> bodies;
+  ContactCache cache;
+  std::uint64_t passes = 0;
+};
+
+/// One snapshot per level of halving, reused from step to step.
+struct PassSnapshots {
+  std::array<PassSnapshot, kMaxHalvings> levels;
+};
 namespace {
 
 // A contact with a sleeping island wakes it; its bodies then need their own contacts, so the
@@ -77,6 +94,8 @@ World::World(const World& other)
       bodies_(other.bodies_),
       time_(other.time_),
       steps_(other.steps_),
+      passes_(other.passes_),
+      halvings_(other.halvings_),
       total_impacts_(other.total_impacts_),
       unequal_moments_(other.unequal_moments_),
       last_(other.last_),
@@ -101,10 +120,21 @@ void World::step() { step(scene_.world.dt); }
 void World::step(double dt) {
   if (!(std::isfinite(dt) && dt > 0.0)) throw InvalidInput("dt must be finite and > 0");
   last_ = {};
-  StepContext ctx{scene_.world, dt,        steps_, bodies_, *cache_,
-                  *broad_,       *scratch_,  last_,  *pool_,  time_stages_,
-                  unequal_moments_ > 0};
   const WorkerPool::Busy busy(*pool_);  // workers poll through the step's serial stretches
+  if (scene_.world.max_overlap > 0.0) {
+    step_within_overlap(dt);
+  } else {
+    pass(dt, last_);
+    total_impacts_ += last_.impacts;
+  }
+  time_ += dt;
+  ++steps_;
+}
+
+void World::pass(double dt, StepStats& stats) {
+  StepContext ctx{scene_.world, dt,        passes_, bodies_, *cache_,
+                  *broad_,       *scratch_,  stats,   *pool_,  time_stages_,
+                  unequal_moments_ > 0};
   for (int round = 0; round < kMaxWakeRounds; ++round) {
     run_stage(Stage::broad_phase, broad_phase, ctx, time_stages_);
     run_stage(Stage::narrow_phase, narrow_phase, ctx, time_stages_);
@@ -115,9 +145,87 @@ void World::step(double dt) {
   run_stage(Stage::flight, flight, ctx, time_stages_);
   run_stage(Stage::finalize, finalize, ctx, time_stages_);
   run_stage(Stage::sleep, update_sleep, ctx, time_stages_);
-  total_impacts_ += last_.impacts;
-  time_ += dt;
-  ++steps_;
+  stats.passes = 1;
+  ++passes_;
+}
+
+namespace {
+
+/// Adds a kept pass's counters to the step's (times are added for every pass, kept or not).
+void add_kept(StepStats& step, const StepStats& pass) {
+  const auto times = step.stage_ns;
+  const auto passes = step.solve_pass_ns;
+  const std::uint32_t impacts = step.impacts + pass.impacts;
+  const std::uint32_t toi = step.toi_iterations + pass.toi_iterations;
+  const std::uint32_t frozen = step.newly_frozen + pass.newly_frozen;
+  const std::uint32_t over = step.pair_budget_exceeded | pass.pair_budget_exceeded;
+  const std::uint32_t runs = step.passes, halved = step.halved_passes;
+  step = pass;
+  step.impacts = impacts;
+  step.toi_iterations = toi;
+  step.newly_frozen = frozen;
+  step.pair_budget_exceeded = over;
+  step.stage_ns = times;
+  step.solve_pass_ns = passes;
+  step.passes = runs;
+  step.halved_passes = halved;
+}
+
+/// Adds a pass's stage times to the step's.
+void add_times(StepStats& step, const StepStats& pass) {
+  for (int i = 0; i < kStageCount; ++i) step.stage_ns[i] += pass.stage_ns[i];
+  for (int i = 0; i < kSolvePassCount; ++i) step.solve_pass_ns[i] += pass.solve_pass_ns[i];
+  ++step.passes;
+}
+
+}  // namespace
+
+// A pass that opens an overlap deeper than max_overlap is undone (bodies, contact cache and
+// the pass count restored; the broad phase's acceleration dropped, which changes no result)
+// and taken again as two passes of dt / 2, each checked the same way, down to kMaxHalvings
+// halvings, where a pass is kept whatever it opens (overlap_bound.cpp says why). As an
+// adaptive integrator grows its step after a success, a step starts with the halvings the
+// step before ended with, less one when that one had to undo nothing: in `pile` the steps
+// that need halving come in runs, and starting each from dt took a quarter more passes.
+void World::step_within_overlap(double dt) {
+  const int start = halvings_;
+  finest_ = start;
+  const int parts = 1 << start;
+  for (int k = 0; k < parts; ++k) step_passes(dt / parts, start);
+  halvings_ = last_.halved_passes == 0 ? std::max(0, start - 1) : finest_;
+}
+
+void World::step_passes(double dt, int halvings) {
+  StepStats stats;
+  finest_ = std::max(finest_, halvings);
+  if (halvings == kMaxHalvings) {
+    pass(dt, stats);
+    add_times(last_, stats);
+    add_kept(last_, stats);
+    total_impacts_ += stats.impacts;
+    return;
+  }
+  if (!snapshots_) snapshots_ = std::make_unique<PassSnapshots>();
+  PassSnapshot& kept = snapshots_->levels[static_cast<std::size_t>(halvings)];
+  kept.bodies = bodies_;
+  kept.cache = *cache_;
+  kept.passes = passes_;
+  pass(dt, stats);
+  add_times(last_, stats);
+  if (overlap_grown(kept.bodies, bodies_, scratch_->pairs, scene_.world, scene_.world.max_overlap,
+                    *pool_) == 0.0) {
+    add_kept(last_, stats);
+    total_impacts_ += stats.impacts;
+    return;
+  }
+  ++last_.halved_passes;
+  bodies_.swap(kept.bodies);
+  std::swap(*cache_, kept.cache);
+  passes_ = kept.passes;
+  *broad_ = BroadPhaseCache{};
+  scratch_->earlier_step = ~std::uint64_t{0};  // its answers were for the pass undone
+  step_passes(0.5 * dt, halvings + 1);
+  step_passes(0.5 * dt, halvings + 1);
 }
 
 BodyId World::add_body(const BodyDef& def) {

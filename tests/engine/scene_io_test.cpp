@@ -29,6 +29,12 @@ TEST(SceneIo, EveryBundledSceneLoadsAndRoundTrips) {
   // The description travels with the scene (the viewer shows it when the scene loads).
   EXPECT_NE(scene_to_json(load_scene("pyramid_large")).value("description", "").find("5050"),
             std::string::npos);
+  // The overlap bound travels with a scene that sets it, and a scene without it has none.
+  Scene bounded = load_scene("pile");
+  EXPECT_EQ(bounded.world.max_overlap, 0.0);
+  EXPECT_FALSE(scene_to_json(bounded).contains("max_overlap"));
+  bounded.world.max_overlap = 0.01;
+  EXPECT_EQ(scene_from_json(scene_to_json(bounded)).world.max_overlap, 0.01);
   const Scene seed = load_scene("seed");
   EXPECT_EQ(seed.world.integrator, Integrator::midpoint);
   EXPECT_EQ(seed.world.toi, ToiMethod::bisection);
@@ -50,6 +56,9 @@ TEST(SceneIo, BadScenesNameTheField) {
   EXPECT_EQ(field_of(R"({"toi": "guess", "bodies": []})"), "toi");
   EXPECT_EQ(field_of(R"({"dt": 0, "bodies": []})"), "dt");
   EXPECT_EQ(field_of(R"({"dt": 1e308, "bodies": []})"), "dt");
+  EXPECT_EQ(field_of(R"({"max_overlap": -0.01, "bodies": []})"), "max_overlap");
+  EXPECT_EQ(field_of(R"({"max_overlap": "1 cm", "bodies": []})"), "max_overlap");
+  EXPECT_EQ(field_of(R"({"max_overlap": 0.01, "bodies": []})"), "<accepted>");
   EXPECT_EQ(field_of(R"({"floor": {"restitution": -0.1}, "bodies": []})"), "floor.restitution");
   EXPECT_EQ(field_of(R"({"floor": {"friction": "x"}, "bodies": []})"), "floor.friction");
   EXPECT_EQ(field_of(R"({"gravity": [0, -9.81], "bodies": []})"), "gravity");

@@ -57,7 +57,14 @@ struct WorldDef {
   Integrator integrator = Integrator::exact;  ///< Flight integrator.
   ToiMethod toi = ToiMethod::root;            ///< Impact-time search.
   double toi_tolerance = 1e-9;                ///< Impact-time tolerance, s.
+  /// Deepest overlap a step may open between two boxes or a box and the floor, m; a step that
+  /// opens a deeper one is taken again as two halves, down to dt / 2^kMaxHalvings. 0: off.
+  double max_overlap = 0.0;
 };
+
+/// Most times World::step halves a pass to keep WorldDef::max_overlap (a step is then at
+/// most 2^(kMaxHalvings+1) − 1 passes).
+inline constexpr int kMaxHalvings = 5;
 
 /// A whole scene.
 struct Scene {

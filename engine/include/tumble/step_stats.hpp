@@ -67,6 +67,11 @@ struct StepStats {
   /// 1 when the broad phase stopped at its pair budget (32 per body + 1,024): bodies packed
   /// into one another beyond it were not tested against each other this step.
   std::uint32_t pair_budget_exceeded = 0;
+  /// Passes of the stages the step ran: 1, more where WorldDef::max_overlap had a pass taken
+  /// again as two halves (the counters above are the kept passes'; the times below, all).
+  std::uint32_t passes = 0;
+  /// Passes taken again as halves because they opened an overlap deeper than max_overlap.
+  std::uint32_t halved_passes = 0;
   /// Wall time of each stage (steady clock), ns, indexed by Stage.
   std::array<std::uint64_t, kStageCount> stage_ns{};
   /// Wall time of each pass of the contact_solve stage (steady clock), ns, indexed by

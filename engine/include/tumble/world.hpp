@@ -30,6 +30,8 @@ struct ContactCache;
 struct BroadPhaseCache;
 /// Per-step buffers of the stages.
 struct StepScratch;
+/// What a step keeps to take a pass again (WorldDef::max_overlap).
+struct PassSnapshots;
 /// Worker threads of the stages.
 class WorkerPool;
 
@@ -134,11 +136,21 @@ class World {
  private:
   /// Builds the broad phase's cache (boxes of the sleeping bodies, sweep order).
   void prime_broad_phase();
+  /// One pass of the stages over dt; its counters into `stats`.
+  void pass(double dt, StepStats& stats);
+  /// The step over dt in passes that keep max_overlap (world.cpp says how many).
+  void step_within_overlap(double dt);
+  /// A pass over dt, taken again as two halves while it opens an overlap deeper than
+  /// max_overlap (`halvings`: how often the step's dt was halved already).
+  void step_passes(double dt, int halvings);
 
   Scene scene_;
   std::vector<Body> bodies_;
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
+  std::uint64_t passes_ = 0;
+  int halvings_ = 0;  // max_overlap: how often the next step starts halved
+  int finest_ = 0;    // max_overlap: the most halvings a pass of this step took  // passes of the stages run (steps_ unless some were halved)
   std::uint64_t total_impacts_ = 0;
   std::size_t unequal_moments_ = 0;  // bodies that are not cubes (whose flight may use lanes)
   StepStats last_;
@@ -147,6 +159,7 @@ class World {
   std::unique_ptr<BroadPhaseCache> broad_;   // sweep orders, fat boxes (acceleration only)
   std::unique_ptr<StepScratch> scratch_;     // per-step buffers
   std::unique_ptr<WorkerPool> pool_;         // threads of the stages (never copied)
+  std::unique_ptr<PassSnapshots> snapshots_; // for max_overlap, made at its first use
 };
 
 }  // namespace tumble

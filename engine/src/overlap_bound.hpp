@@ -1,0 +1,23 @@
+#pragma once
+/// The check behind WorldDef::max_overlap: whether one pass of a step let two boxes, or a box
+/// and the floor, sink into each other deeper than the bound and deeper than they were when
+/// the pass began. World::step takes such a pass again as two halves (world.cpp).
+#include <span>
+
+#include "broad_phase.hpp"
+#include "tumble/body.hpp"
+#include "tumble/scene.hpp"
+#include "worker_pool.hpp"
+
+namespace tumble {
+
+/// The deepest overlap, m, of the pairs of `pairs` (ids into both spans) that overlap deeper
+/// than `bound` (m, > 0) in `after` and deeper than they did in `before`, and of the awake
+/// bodies of `after` deeper than `bound` in the floor (if any) and deeper than they were;
+/// 0 when there is none. `before` and `after` hold the same bodies at a pass's start and end.
+/// Reads only; shares the pairs among pool's threads (the result is the same for any count).
+double overlap_grown(std::span<const Body> before, std::span<const Body> after,
+                  std::span<const BodyPair> pairs, const WorldDef& world, double bound,
+                  WorkerPool& pool);
+
+}  // namespace tumble
