@@ -74,7 +74,12 @@ std::string closing_note_contact(const std::map<std::string, std::string>& v) {
        "deepest overlap is "
     << fmt(100.0 * number(v, pp + "tumble.deepest_m")) << " cm (Bullet "
     << fmt(100.0 * number(v, pp + "bullet.deepest_m")) << " cm); Tumble keeps 1 cm "
-    << within("tumble") << ", Bullet " << within("bullet") << ". ";
+    << within("tumble") << ", Bullet " << within("bullet") << ". With the scene's overlap bound "
+    << "at 1 cm (`max_overlap`, `tumble-bounded`) Tumble's deepest at dt = 1/60 is "
+    << fmt(100.0 * number(v, pp + "tumble-bounded.deepest_m")) << " cm for "
+    << fmt(number(v, pp + "tumble-bounded.cpu_per_sim_s")) << " CPU s per simulated s ("
+    << fmt(number(v, pp + "tumble-bounded.cpu_per_sim_s") / number(v, pp + "tumble.cpu_per_sim_s"))
+    << "× the plain run's). ";
   const double matched = number(v, pp + "bullet.cpu_ratio_at_tumble_depth");
   s << (std::isnan(matched) ? std::string("Bullet is deeper than Tumble's 1/60 overlap at every dt")
                             : "At Tumble's 1/60 overlap Bullet takes " + fmt(matched) +

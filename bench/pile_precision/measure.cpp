@@ -43,6 +43,21 @@ Point run(const Contender& c, const tumble::Scene& s, long steps, double budget)
   return p;
 }
 
+/// The engines in table order: Tumble, Tumble with the scene's overlap bound at kBound
+/// (WorldDef::max_overlap), then the peers.
+std::vector<Contender> engines_with_bound() {
+  std::vector<Contender> engines = contenders();
+  Contender bounded = engines.front();
+  bounded.name = kBoundedName;
+  bounded.make = [plain = engines.front().make](const tumble::Scene& s, const PeerSetup& setup) {
+    tumble::Scene with_bound = s;
+    with_bound.world.max_overlap = kBound;
+    return plain(with_bound, setup);
+  };
+  engines.insert(engines.begin() + 1, bounded);
+  return engines;
+}
+
 }  // namespace
 
 Measurement measure(const Options& o) {
@@ -53,7 +68,7 @@ Measurement measure(const Options& o) {
   m.dts = o.quick ? std::vector<double>{1.0 / 60, 1.0 / 120}
                   : std::vector<double>{1.0 / 60, 1.0 / 120, 1.0 / 240, 1.0 / 480};
   const tumble::Scene pile = bundled("pile");
-  const std::vector<Contender> engines = contenders();
+  const std::vector<Contender> engines = engines_with_bound();
   for (const Contender& c : engines) m.engines.push_back(c.name);
   m.initial = contact::deepest_penetration(*engines.front().make(pile, {}), pile);
   Progress bar("pile-precision", m.dts.size() * engines.size());

@@ -12,6 +12,8 @@ namespace tumble_bench::pile_precision {
 
 /// The overlap the question asks about: the engine issue's bound for `pile`, m.
 inline constexpr double kBound = 0.01;
+/// Tumble with the scene's max_overlap set to kBound, as a contender of its own.
+inline constexpr const char* kBoundedName = "tumble-bounded";
 
 /// One engine at one step size: `pile` from its start for the measured interval.
 struct Point {

@@ -50,7 +50,7 @@ std::string matched(const Measurement& m) {
   if (!std::isfinite(tumble.cpu_per_sim_s)) return "";
   std::vector<std::string> items;
   for (const std::string& engine : m.engines) {
-    if (engine == tumble.engine) continue;
+    if (engine == tumble.engine || engine == kBoundedName) continue;
     bool at_most = false;
     const double cpu = cpu_at_depth(m, engine, tumble.deepest, &at_most);
     if (std::isnan(cpu)) {

@@ -12,6 +12,7 @@ set title 'pile: deepest overlap against run time, dt = 1/60 ... 1/480'
 set xlabel 'CPU s per simulated second'
 set ylabel 'deepest overlap (m)'
 plot 'pile_precision.csv' skip 1 using (strcol(1) eq 'tumble' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'tumble', \
+     'pile_precision.csv' skip 1 using (strcol(1) eq 'tumble-bounded' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'tumble-bounded', \
      'pile_precision.csv' skip 1 using (strcol(1) eq 'bullet' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'bullet', \
      'pile_precision.csv' skip 1 using (strcol(1) eq 'ode' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'ode', \
      'pile_precision.csv' skip 1 using (strcol(1) eq 'box3d' ? $4 : 1/0):(max($5, 1e-17)) with linespoints lw 1.5 title 'box3d', \
