@@ -15,11 +15,29 @@ double floor_depth(const Body& b, double height) {
   return height - (b.s.x.y() - reach);
 }
 
+/// What a pass started from: body i's record then.
+class Before {
+ public:
+  Before(std::span<const std::uint32_t> moved, std::span<const Body> before,
+         std::span<const Body> after)
+      : moved_(moved), before_(before), after_(after) {}
+  /// Body i at the pass's start.
+  const Body& operator[](std::uint32_t i) const {
+    const auto it = std::lower_bound(moved_.begin(), moved_.end(), i);
+    return it != moved_.end() && *it == i ? before_[static_cast<std::size_t>(it - moved_.begin())]
+                                          : after_[i];
+  }
+
+ private:
+  std::span<const std::uint32_t> moved_;
+  std::span<const Body> before_, after_;
+};
+
 /// How deep boxes i and j end when that is deeper than `bound` and deeper than they began, else
 /// 0. Most pairs end at the bounding spheres or at the first face axis (box_depth stops at
 /// `bound`); only a pair deeper than the bound at the end is measured exactly.
-double pair_grown(std::span<const Body> before, std::span<const Body> after, const BodyPair& p,
-               double bound) {
+double pair_grown(const Before& before, std::span<const Body> after, const BodyPair& p,
+                  double bound) {
   const Body& a = after[p.first];
   const Body& b = after[p.second];
   const double reach = a.c.bounding_radius + b.c.bounding_radius - bound;
@@ -40,15 +58,16 @@ double pair_grown(std::span<const Body> before, std::span<const Body> after, con
 // step whose error estimate is over its tolerance (Hairer, Nørsett & Wanner, "Solving
 // Ordinary Differential Equations I", §II.4); here the estimate is the overlap itself, exact
 // for boxes by the separating axes.
-double overlap_grown(std::span<const Body> before, std::span<const Body> after,
-                     std::span<const BodyPair> pairs, const WorldDef& world, double bound,
-                     WorkerPool& pool) {
+double overlap_grown(std::span<const std::uint32_t> moved, std::span<const Body> before,
+                     std::span<const Body> after, std::span<const BodyPair> pairs,
+                     const WorldDef& world, double bound, WorkerPool& pool) {
+  const Before start(moved, before, after);
   constexpr std::size_t kGrain = 512;  // pairs per chunk: ~20 ns each, most ending early
   std::atomic<double> deepest = 0.0;   // a maximum: the same whatever order the chunks run in
   pool.for_each(pairs.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     double chunk = 0.0;
     for (std::size_t k = begin; k < end; ++k)
-      chunk = std::max(chunk, pair_grown(before, after, pairs[k], bound));
+      chunk = std::max(chunk, pair_grown(start, after, pairs[k], bound));
     double seen = deepest.load(std::memory_order_relaxed);
     while (chunk > seen && !deepest.compare_exchange_weak(seen, chunk, std::memory_order_relaxed)) {
     }
@@ -56,10 +75,9 @@ double overlap_grown(std::span<const Body> before, std::span<const Body> after,
   double result = deepest.load();
   if (!world.floor) return result;
   const double height = world.floor->height;
-  for (std::size_t i = 0; i < after.size(); ++i) {
-    if (after[i].activity != Activity::awake) continue;
-    const double end = floor_depth(after[i], height);
-    if (end > bound && end > floor_depth(before[i], height)) result = std::max(result, end);
+  for (std::size_t k = 0; k < moved.size(); ++k) {
+    const double end = floor_depth(after[moved[k]], height);
+    if (end > bound && end > floor_depth(before[k], height)) result = std::max(result, end);
   }
   return result;
 }

@@ -11,13 +11,14 @@
 
 namespace tumble {
 
-/// The deepest overlap, m, of the pairs of `pairs` (ids into both spans) that overlap deeper
-/// than `bound` (m, > 0) in `after` and deeper than they did in `before`, and of the awake
-/// bodies of `after` deeper than `bound` in the floor (if any) and deeper than they were;
-/// 0 when there is none. `before` and `after` hold the same bodies at a pass's start and end.
-/// Reads only; shares the pairs among pool's threads (the result is the same for any count).
-double overlap_grown(std::span<const Body> before, std::span<const Body> after,
-                  std::span<const BodyPair> pairs, const WorldDef& world, double bound,
-                  WorkerPool& pool);
+/// The deepest overlap, m, of the pairs of `pairs` (ids into `after`) that overlap deeper
+/// than `bound` (m, > 0) in `after` and deeper than they did at the pass's start, and of the
+/// bodies `moved` deeper than `bound` in the floor (if any) and deeper than they were; 0 when
+/// there is none. At the pass's start body moved[k] was before[k] (ids ascending), and every
+/// other body was as it is in `after`. Reads only; shares the pairs among pool's threads (the
+/// result is the same for any count).
+double overlap_grown(std::span<const std::uint32_t> moved, std::span<const Body> before,
+                     std::span<const Body> after, std::span<const BodyPair> pairs,
+                     const WorldDef& world, double bound, WorkerPool& pool);
 
 }  // namespace tumble

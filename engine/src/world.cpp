@@ -14,9 +14,12 @@
 
 namespace tumble {
 
-/// The state a pass can change, kept to take it again: one per halving level.
+/// What the rest of a pass can change once its contacts are found, kept to take it again:
+/// the awake bodies (the others stay as they are), the contact cache and the pass count.
 struct PassSnapshot {
-  std::vector<Body> bodies;
+  bool taken = false;                // the pass had pairs to check (else nothing was kept)
+  std::vector<std::uint32_t> ids;    // the awake bodies, ascending
+  std::vector<Body> bodies;          // their records
   ContactCache cache;
   std::uint64_t passes = 0;
 };
@@ -124,14 +127,14 @@ void World::step(double dt) {
   if (scene_.world.max_overlap > 0.0) {
     step_within_overlap(dt);
   } else {
-    pass(dt, last_);
+    pass(dt, last_, nullptr);
     total_impacts_ += last_.impacts;
   }
   time_ += dt;
   ++steps_;
 }
 
-void World::pass(double dt, StepStats& stats) {
+void World::pass(double dt, StepStats& stats, PassSnapshot* keep) {
   StepContext ctx{scene_.world, dt,        passes_, bodies_, *cache_,
                   *broad_,       *scratch_,  stats,   *pool_,  time_stages_,
                   unequal_moments_ > 0};
@@ -140,6 +143,7 @@ void World::pass(double dt, StepStats& stats) {
     run_stage(Stage::narrow_phase, narrow_phase, ctx, time_stages_);
     if (ctx.scratch.woken == 0) break;
   }
+  if (keep) take_snapshot(*keep);
   run_stage(Stage::islands, islands, ctx, time_stages_);
   run_stage(Stage::contact_solve, contact_solve, ctx, time_stages_);
   run_stage(Stage::flight, flight, ctx, time_stages_);
@@ -198,34 +202,45 @@ void World::step_within_overlap(double dt) {
 void World::step_passes(double dt, int halvings) {
   StepStats stats;
   finest_ = std::max(finest_, halvings);
-  if (halvings == kMaxHalvings) {
-    pass(dt, stats);
-    add_times(last_, stats);
-    add_kept(last_, stats);
-    total_impacts_ += stats.impacts;
-    return;
-  }
   if (!snapshots_) snapshots_ = std::make_unique<PassSnapshots>();
-  PassSnapshot& kept = snapshots_->levels[static_cast<std::size_t>(halvings)];
-  kept.bodies = bodies_;
-  kept.cache = *cache_;
-  kept.passes = passes_;
-  pass(dt, stats);
+  PassSnapshot* kept =
+      halvings < kMaxHalvings ? &snapshots_->levels[static_cast<std::size_t>(halvings)] : nullptr;
+  pass(dt, stats, kept);
   add_times(last_, stats);
-  if (overlap_grown(kept.bodies, bodies_, scratch_->pairs, scene_.world, scene_.world.max_overlap,
-                    *pool_) == 0.0) {
+  if (!kept || !kept->taken ||
+      overlap_grown(kept->ids, kept->bodies, bodies_, scratch_->pairs, scene_.world,
+                    scene_.world.max_overlap, *pool_) == 0.0) {
     add_kept(last_, stats);
     total_impacts_ += stats.impacts;
     return;
   }
   ++last_.halved_passes;
-  bodies_.swap(kept.bodies);
-  std::swap(*cache_, kept.cache);
-  passes_ = kept.passes;
+  for (std::size_t k = 0; k < kept->ids.size(); ++k) bodies_[kept->ids[k]] = kept->bodies[k];
+  std::swap(*cache_, kept->cache);
+  passes_ = kept->passes;
   *broad_ = BroadPhaseCache{};
   scratch_->earlier_step = ~std::uint64_t{0};  // its answers were for the pass undone
   step_passes(0.5 * dt, halvings + 1);
   step_passes(0.5 * dt, halvings + 1);
+}
+
+// Taken after the pass's contacts are found: until then nothing has moved, and only now is it
+// known whether the pass has any pair to check. A pass without one (bodies in flight, boxes
+// resting apart) keeps nothing and costs what it costs without the bound; lone bodies meet the
+// floor at their time of impact, so only pairs can sink (an island's floor contacts included:
+// an island is made of pairs).
+void World::take_snapshot(PassSnapshot& keep) const {
+  keep.taken = !scratch_->pairs.empty();
+  if (!keep.taken) return;
+  keep.ids.clear();
+  keep.bodies.clear();
+  for (std::uint32_t i = 0; i < bodies_.size(); ++i) {
+    if (bodies_[i].activity != Activity::awake) continue;
+    keep.ids.push_back(i);
+    keep.bodies.push_back(bodies_[i]);
+  }
+  keep.cache = *cache_;
+  keep.passes = passes_;
 }
 
 BodyId World::add_body(const BodyDef& def) {

@@ -32,6 +32,8 @@ struct BroadPhaseCache;
 struct StepScratch;
 /// What a step keeps to take a pass again (WorldDef::max_overlap).
 struct PassSnapshots;
+/// One of them.
+struct PassSnapshot;
 /// Worker threads of the stages.
 class WorkerPool;
 
@@ -136,8 +138,11 @@ class World {
  private:
   /// Builds the broad phase's cache (boxes of the sleeping bodies, sweep order).
   void prime_broad_phase();
-  /// One pass of the stages over dt; its counters into `stats`.
-  void pass(double dt, StepStats& stats);
+  /// One pass of the stages over dt; its counters into `stats`. With `keep`, what the pass
+  /// changes after its contacts are found is kept there first (take_snapshot).
+  void pass(double dt, StepStats& stats, PassSnapshot* keep);
+  /// Keeps the awake bodies, the contact cache and the pass count, if the pass has pairs.
+  void take_snapshot(PassSnapshot& keep) const;
   /// The step over dt in passes that keep max_overlap (world.cpp says how many).
   void step_within_overlap(double dt);
   /// A pass over dt, taken again as two halves while it opens an overlap deeper than
