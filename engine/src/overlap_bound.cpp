@@ -33,9 +33,18 @@ class Before {
   std::span<const Body> before_, after_;
 };
 
-/// How deep boxes i and j end when that is deeper than `bound` and deeper than they began, else
-/// 0. Most pairs end at the bounding spheres or at the first face axis (box_depth stops at
-/// `bound`); only a pair deeper than the bound at the end is measured exactly.
+/// Whether a pair or a box on the floor that ends `end` deep (m, > bound) after starting
+/// `start` deep broke the bound: it crossed it, or it was past it already (a scene that places
+/// boxes inside each other, the last halves kept) and sank a quarter of the bound further.
+/// Without that quarter a pair resting just past the bound, whose depth moves by round-off,
+/// would halve every pass.
+bool broke(double start, double end, double bound) {
+  return start <= bound || end > start + 0.25 * bound;
+}
+
+/// How deep boxes i and j end when that broke the bound, else 0. Most pairs end at the
+/// bounding spheres or at the first face axis (box_depth stops at `bound`); only a pair deeper
+/// than the bound at the end is measured exactly.
 double pair_grown(const Before& before, std::span<const Body> after, const BodyPair& p,
                   double bound) {
   const Body& a = after[p.first];
@@ -46,7 +55,7 @@ double pair_grown(const Before& before, std::span<const Body> after, const BodyP
   const double end = box_depth(a.s, a.c, b.s, b.c, -INFINITY);
   const Body& a0 = before[p.first];
   const Body& b0 = before[p.second];
-  return end > box_depth(a0.s, a0.c, b0.s, b0.c, -INFINITY) ? end : 0.0;
+  return broke(box_depth(a0.s, a0.c, b0.s, b0.c, -INFINITY), end, bound) ? end : 0.0;
 }
 
 }  // namespace
@@ -77,7 +86,8 @@ double overlap_grown(std::span<const std::uint32_t> moved, std::span<const Body>
   const double height = world.floor->height;
   for (std::size_t k = 0; k < moved.size(); ++k) {
     const double end = floor_depth(after[moved[k]], height);
-    if (end > bound && end > floor_depth(before[k], height)) result = std::max(result, end);
+    if (end > bound && broke(floor_depth(before[k], height), end, bound))
+      result = std::max(result, end);
   }
   return result;
 }

@@ -71,8 +71,10 @@ std::optional<SceneError> validate(const Scene& scene) {
     return SceneError{"dt", "must be within (0, 1] s"};
   if (!std::isfinite(w.toi_tolerance) || w.toi_tolerance < 1e-15 || w.toi_tolerance > w.dt)
     return SceneError{"toi_tolerance", "must be within [1e-15 s, dt]"};
-  if (!(w.max_overlap >= 0.0 && w.max_overlap <= 1.0))
-    return SceneError{"max_overlap", "must be within [0, 1] m (0: off)"};
+  if (!(w.max_overlap == 0.0 || (w.max_overlap >= kMinMaxOverlap && w.max_overlap <= 1.0)))
+    return SceneError{"max_overlap",
+                      "must be 0 (off) or within [0.001, 1] m (resting contacts themselves overlap "
+                      "by up to 0.2 mm)"};
   if (w.floor) {
     if (!std::isfinite(w.floor->height) || std::abs(w.floor->height) > 1e6)
       return SceneError{"floor.height", "must be finite and within 1e6 m"};

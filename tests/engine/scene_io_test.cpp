@@ -58,7 +58,9 @@ TEST(SceneIo, BadScenesNameTheField) {
   EXPECT_EQ(field_of(R"({"dt": 1e308, "bodies": []})"), "dt");
   EXPECT_EQ(field_of(R"({"max_overlap": -0.01, "bodies": []})"), "max_overlap");
   EXPECT_EQ(field_of(R"({"max_overlap": "1 cm", "bodies": []})"), "max_overlap");
+  EXPECT_EQ(field_of(R"({"max_overlap": 1e-4, "bodies": []})"), "max_overlap");  // < 1 mm
   EXPECT_EQ(field_of(R"({"max_overlap": 0.01, "bodies": []})"), "<accepted>");
+  EXPECT_EQ(field_of(R"({"max_overlap": 0, "bodies": []})"), "<accepted>");
   EXPECT_EQ(field_of(R"({"floor": {"restitution": -0.1}, "bodies": []})"), "floor.restitution");
   EXPECT_EQ(field_of(R"({"floor": {"friction": "x"}, "bodies": []})"), "floor.friction");
   EXPECT_EQ(field_of(R"({"gravity": [0, -9.81], "bodies": []})"), "gravity");

@@ -57,10 +57,16 @@ struct WorldDef {
   Integrator integrator = Integrator::exact;  ///< Flight integrator.
   ToiMethod toi = ToiMethod::root;            ///< Impact-time search.
   double toi_tolerance = 1e-9;                ///< Impact-time tolerance, s.
-  /// Deepest overlap a step may open between two boxes or a box and the floor, m; a step that
-  /// opens a deeper one is taken again as two halves, down to dt / 2^kMaxHalvings. 0: off.
+  /// Deepest overlap a step may open between two boxes or a box and the floor, m (0: off, else
+  /// at least kMinMaxOverlap); a step that opens a deeper one is taken again as two halves,
+  /// down to dt / 2^kMaxHalvings.
   double max_overlap = 0.0;
 };
+
+/// Least WorldDef::max_overlap other than 0, m: five times the 0.2 mm a resting contact may
+/// overlap (the contact solver leaves that much alone), so that boxes coming to rest do not
+/// keep a step halving.
+inline constexpr double kMinMaxOverlap = 1e-3;
 
 /// Most times World::step halves a pass to keep WorldDef::max_overlap (a step is then at
 /// most 2^(kMaxHalvings+1) − 1 passes).
