@@ -102,6 +102,8 @@ int main(int argc, char** argv) {
       ("dt", po::value<double>(), "physics step in seconds (default: the scene's)")
       ("integrator", po::value<std::string>(), "euler|midpoint|rk4|symplectic_euler|splitting|exact")
       ("toi", po::value<std::string>(), "bisection|root")
+      ("max-overlap", po::value<double>(), "deepest a step may sink boxes into each other, m "
+                                           "(0: off, else at least 0.001; default: the scene's)")
       ("every", po::value(&o.every), "CSV row every N steps (default 1)")
       ("threads", po::value(&o.threads), "threads per step (default: one per core); any count gives the same result")
       ("csv", po::value<std::string>(), "write body states to this CSV file")
@@ -153,6 +155,7 @@ int main(int argc, char** argv) {
     if (!m) return usage_error("--toi: unknown \"" + vm["toi"].as<std::string>() + "\"", desc);
     scene.world.toi = *m;
   }
+  if (vm.count("max-overlap")) scene.world.max_overlap = vm["max-overlap"].as<double>();
   if (auto error = tumble::validate(scene)) return usage_error(error->field + ": " + error->message, desc);
 
   std::ofstream csv;
@@ -167,11 +170,12 @@ int main(int argc, char** argv) {
   world.set_threads(o.threads);
   const long steps = std::lround(o.duration / scene.world.dt);
   if (csv.is_open()) write_rows(csv, world);
-  std::uint64_t body_steps = 0;
+  std::uint64_t body_steps = 0, passes = 0;
   const auto start = std::chrono::steady_clock::now();
   for (long k = 1; k <= steps; ++k) {
     world.step();
     body_steps += world.bodies().size();
+    passes += world.last_step().passes;
     if (csv.is_open() && (k % o.every == 0 || k == steps)) write_rows(csv, world);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -180,6 +184,8 @@ int main(int argc, char** argv) {
       {"integrator", std::string(tumble::to_string(scene.world.integrator))},
       {"toi", std::string(tumble::to_string(scene.world.toi))},
       {"steps", steps},
+      {"max_overlap", scene.world.max_overlap},
+      {"passes", passes},
       {"threads", world.threads()},
       {"bodies", world.bodies().size()},
       {"impacts", world.total_impacts()},
