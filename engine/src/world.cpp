@@ -134,7 +134,10 @@ void World::step(double dt) {
   ++steps_;
 }
 
-void World::pass(double dt, StepStats& stats, PassSnapshot* keep) {
+// Inlined into its two callers: as a call of its own it cost a lone body's step 26 of its
+// ~1,240 instructions (callgrind, `bounce`).
+[[gnu::always_inline]] inline void World::pass(double dt, StepStats& stats,
+                                               PassSnapshot* keep) {
   StepContext ctx{scene_.world, dt,        passes_, bodies_, *cache_,
                   *broad_,       *scratch_,  stats,   *pool_,  time_stages_,
                   unequal_moments_ > 0};
