@@ -17,7 +17,8 @@
 ///   finalize      → finalize.cpp      finiteness (freeze) and re-orthonormalisation
 ///   update_sleep  → sleep.cpp         one rule: an island still for long enough sleeps
 ///
-/// The World's owner thread runs the stages; a stage may share independent work (bodies,
+/// That list is one pass; World::step runs one pass, or with WorldDef::max_overlap as many as
+/// keep the bound (world.cpp, overlap_bound.cpp). The World's owner thread runs the stages; a stage may share independent work (bodies,
 /// pairs, contacts of one colour) among the threads of ctx.pool, each index writing only its
 /// own outputs, so results are bit-identical for any number of threads.
 #include <cstdint>
