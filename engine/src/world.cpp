@@ -188,7 +188,7 @@ void add_times(StepStats& step, const StepStats& pass) {
 }  // namespace
 
 // A pass that opens an overlap deeper than max_overlap is undone (bodies, contact cache and
-// the pass count restored; the broad phase's acceleration dropped, which changes no result)
+// the pass count restored; the broad phase's acceleration rebuilt, which changes no result)
 // and taken again as two passes of dt / 2, each checked the same way, down to kMaxHalvings
 // halvings, where a pass is kept whatever it opens (overlap_bound.cpp says why). As an
 // adaptive integrator grows its step after a success, a step starts with the halvings the
@@ -221,7 +221,8 @@ void World::step_passes(double dt, int halvings) {
   for (std::size_t k = 0; k < kept->ids.size(); ++k) bodies_[kept->ids[k]] = kept->bodies[k];
   std::swap(*cache_, kept->cache);
   passes_ = kept->passes;
-  *broad_ = BroadPhaseCache{};
+  ++cache_->activity_epoch;  // the broad phase rescans every body and sweeps again
+  broad_->fat_valid = false;
   scratch_->earlier_step = ~std::uint64_t{0};  // its answers were for the pass undone
   step_passes(0.5 * dt, halvings + 1);
   step_passes(0.5 * dt, halvings + 1);
