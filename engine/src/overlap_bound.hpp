@@ -1,7 +1,7 @@
 #pragma once
 /// The check behind WorldDef::max_overlap: whether one pass of a step let two boxes, or a box
 /// and the floor, sink into each other deeper than the bound and deeper than they were when
-/// the pass began. World::step takes such a pass again as two halves (world.cpp).
+/// the pass began. World::step takes such a pass again as two halves (world_step.cpp).
 #include <span>
 
 #include "broad_phase.hpp"

@@ -18,7 +18,9 @@
 ///   update_sleep  → sleep.cpp         one rule: an island still for long enough sleeps
 ///
 /// That list is one pass; World::step runs one pass, or with WorldDef::max_overlap as many as
-/// keep the bound (world.cpp, overlap_bound.cpp). The World's owner thread runs the stages; a stage may share independent work (bodies,
+/// keep the bound (world_step.cpp, overlap_bound.cpp).
+///
+/// The World's owner thread runs the stages; a stage may share independent work (bodies,
 /// pairs, contacts of one colour) among the threads of ctx.pool, each index writing only its
 /// own outputs, so results are bit-identical for any number of threads.
 #include <cstdint>

@@ -143,7 +143,7 @@ class World {
   void pass(double dt, StepStats& stats, PassSnapshot* keep);
   /// Keeps the awake bodies, the contact cache and the pass count, if the pass has pairs.
   void take_snapshot(PassSnapshot& keep) const;
-  /// The step over dt in passes that keep max_overlap (world.cpp says how many).
+  /// The step over dt in passes that keep max_overlap (world_step.cpp says how many).
   void step_within_overlap(double dt);
   /// A pass over dt, taken again as two halves while it opens an overlap deeper than
   /// max_overlap (`halvings`: how often the step's dt was halved already).
