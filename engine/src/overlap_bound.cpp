@@ -42,7 +42,7 @@ bool broke(double start, double end, double bound) {
   return start <= bound || end > start + 0.25 * bound;
 }
 
-/// How deep boxes i and j end when that broke the bound, else 0. Most pairs end at the
+/// How deep the pair's boxes end when that broke the bound, else 0. Most pairs end at the
 /// bounding spheres or at the first face axis (box_depth stops at `bound`); only a pair deeper
 /// than the bound at the end is measured exactly.
 double pair_grown(const Before& before, std::span<const Body> after, const BodyPair& p,

@@ -69,24 +69,21 @@ void World::step(double dt) {
 
 namespace {
 
-/// Adds a kept pass's counters to the step's (times are added for every pass, kept or not).
+/// Adds a kept pass's counters to the step's: what happened is summed over the kept passes
+/// (impacts, their searches, bodies frozen, the pair budget), the picture of the world (pairs,
+/// contacts, islands …) is the last kept pass's, and the times and pass counts stay the step's
+/// (add_times counts every pass, kept or not).
 void add_kept(StepStats& step, const StepStats& pass) {
-  const auto times = step.stage_ns;
-  const auto passes = step.solve_pass_ns;
-  const std::uint32_t impacts = step.impacts + pass.impacts;
-  const std::uint32_t toi = step.toi_iterations + pass.toi_iterations;
-  const std::uint32_t frozen = step.newly_frozen + pass.newly_frozen;
-  const std::uint32_t over = step.pair_budget_exceeded | pass.pair_budget_exceeded;
-  const std::uint32_t runs = step.passes, halved = step.halved_passes;
-  step = pass;
-  step.impacts = impacts;
-  step.toi_iterations = toi;
-  step.newly_frozen = frozen;
-  step.pair_budget_exceeded = over;
-  step.stage_ns = times;
-  step.solve_pass_ns = passes;
-  step.passes = runs;
-  step.halved_passes = halved;
+  StepStats sum = pass;
+  sum.impacts += step.impacts;
+  sum.toi_iterations += step.toi_iterations;
+  sum.newly_frozen += step.newly_frozen;
+  sum.pair_budget_exceeded |= step.pair_budget_exceeded;
+  sum.stage_ns = step.stage_ns;
+  sum.solve_pass_ns = step.solve_pass_ns;
+  sum.passes = step.passes;
+  sum.halved_passes = step.halved_passes;
+  step = sum;
 }
 
 /// Adds a pass's stage times to the step's.

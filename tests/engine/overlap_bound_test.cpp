@@ -103,7 +103,7 @@ TEST(MaxOverlap, FallingBoxesNeverSinkDeeperThanTheBound) {
     World plain(falling_boxes(speed, spin, 0.0));
     World bounded(falling_boxes(speed, spin, 0.01));
     double plain_deepest = 0.0;
-    std::uint64_t passes = 0, halved = 0;
+    std::uint64_t passes = 0, halved = 0, impacts = 0;
     for (int i = 0; i < 120; ++i) {
       plain.step();
       bounded.step();
@@ -111,12 +111,14 @@ TEST(MaxOverlap, FallingBoxesNeverSinkDeeperThanTheBound) {
       ASSERT_LE(deepest(bounded), 0.01) << "speed " << speed << " spin " << spin << " step " << i;
       passes += bounded.last_step().passes;
       halved += bounded.last_step().halved_passes;
+      impacts += bounded.last_step().impacts;  // the kept passes' only
       EXPECT_EQ(plain.last_step().passes, 1u);
     }
     // The scene does sink at dt = 1/60 without the bound, and the bound took more passes.
     EXPECT_GT(plain_deepest, 0.03) << "speed " << speed << " spin " << spin;
     EXPECT_GT(halved, 0u);
     EXPECT_GT(passes, 120u + halved);
+    EXPECT_EQ(impacts, bounded.total_impacts());
     EXPECT_NEAR(bounded.time(), plain.time(), 1e-12);
     EXPECT_EQ(bounded.step_count(), 120u);
   }
