@@ -153,9 +153,9 @@ class World {
   std::vector<Body> bodies_;
   double time_ = 0.0;
   std::uint64_t steps_ = 0;
-  std::uint64_t passes_ = 0;
-  int halvings_ = 0;  // max_overlap: how often the next step starts halved
-  int finest_ = 0;    // max_overlap: the most halvings a pass of this step took  // passes of the stages run (steps_ unless some were halved)
+  std::uint64_t passes_ = 0;  // passes of the stages run (steps_ unless some were halved)
+  int halvings_ = 0;          // max_overlap: how often the next step starts halved
+  int finest_ = 0;            // max_overlap: the most halvings a pass of this step took
   std::uint64_t total_impacts_ = 0;
   std::size_t unequal_moments_ = 0;  // bodies that are not cubes (whose flight may use lanes)
   StepStats last_;
