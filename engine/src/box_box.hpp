@@ -49,7 +49,8 @@ std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, c
 /// Penetration depth of boxes a and b, m (≤ 0 when they are apart): the least overlap of their
 /// projections over the 15 separating axes, which for two boxes is the shortest translation
 /// that separates them. Returns as soon as one axis shows the depth is at most `enough`, with
-/// that axis's overlap (≤ enough); pass −INFINITY for the exact depth.
+/// that axis's overlap (≤ enough); a result above `enough` is the exact depth (pass −INFINITY
+/// to always have it).
 double box_depth(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                  const BodyConstants& cb, double enough);
 

@@ -43,16 +43,17 @@ bool broke(double start, double end, double bound) {
 }
 
 /// How deep the pair's boxes end when that broke the bound, else 0. Most pairs end at the
-/// bounding spheres or at the first face axis (box_depth stops at `bound`); only a pair deeper
-/// than the bound at the end is measured exactly.
+/// bounding spheres or at the first face axis (box_depth stops at `bound`); a pair deeper than
+/// the bound went through all 15 axes, so its depth is exact, and only it is measured at the
+/// pass's start.
 double pair_grown(const Before& before, std::span<const Body> after, const BodyPair& p,
                   double bound) {
   const Body& a = after[p.first];
   const Body& b = after[p.second];
   const double reach = a.c.bounding_radius + b.c.bounding_radius - bound;
   if ((b.s.x - a.s.x).squaredNorm() >= reach * reach && reach > 0.0) return 0.0;
-  if (box_depth(a.s, a.c, b.s, b.c, bound) <= bound) return 0.0;
-  const double end = box_depth(a.s, a.c, b.s, b.c, -INFINITY);
+  const double end = box_depth(a.s, a.c, b.s, b.c, bound);
+  if (end <= bound) return 0.0;
   const Body& a0 = before[p.first];
   const Body& b0 = before[p.second];
   return broke(box_depth(a0.s, a0.c, b0.s, b0.c, -INFINITY), end, bound) ? end : 0.0;
