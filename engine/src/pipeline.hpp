@@ -48,7 +48,8 @@ struct SleepAnchor {
   Eigen::Matrix3f R = Eigen::Matrix3f::Zero();  ///< Orientation (body → world).
 };
 
-/// What persists between steps and decides results: copied with the World.
+/// What persists between steps and decides results: copied with the World, and by copy_cache
+/// (pass_snapshot.hpp) for a pass taken again.
 struct ContactCache {
   /// Ring of each sleeping island: sleep_next[i] is the next member (i itself when alone).
   std::vector<std::uint32_t> sleep_next;

@@ -113,9 +113,10 @@ void World::step_within_overlap(double dt) {
 void World::step_passes(double dt, int halvings) {
   StepStats stats;
   finest_ = std::max(finest_, halvings);
-  if (!snapshots_) snapshots_ = std::make_unique<PassSnapshots>();
-  PassSnapshot* kept =
-      halvings < kMaxHalvings ? &snapshots_->levels[static_cast<std::size_t>(halvings)] : nullptr;
+  // One snapshot serves every level: a failed pass is put back from it before its halves
+  // take theirs, and a pass that keeps the bound never goes back.
+  if (!snapshot_) snapshot_ = std::make_unique<PassSnapshot>();
+  PassSnapshot* kept = halvings < kMaxHalvings ? snapshot_.get() : nullptr;
   pass(dt, stats, kept);
   add_times(last_, stats);
   if (!kept || !kept->taken ||
@@ -151,7 +152,7 @@ void World::take_snapshot(PassSnapshot& keep) const {
     keep.ids.push_back(i);
     keep.bodies.push_back(bodies_[i]);
   }
-  keep.cache = *cache_;
+  copy_cache(keep.cache, *cache_);
   keep.passes = passes_;
 }
 

@@ -65,27 +65,6 @@ TEST(BoxDepth, IsTheLeastOverlapOverTheFifteenAxes) {
   EXPECT_GT(overlapping, 200);  // the draws test overlapping boxes, not only apart ones
 }
 
-/// Four spinning boxes fall at `speed` onto one that rests on the floor (dt = 1/60).
-Scene falling_boxes(double speed, double spin, double max_overlap) {
-  Scene s;
-  s.world.max_overlap = max_overlap;
-  s.world.floor = Floor{0.0, 0.0, 0.5};
-  BodyDef base;
-  base.name = "base";
-  base.position = {0, 0.5, 0};
-  s.bodies.push_back(base);
-  for (int k = 0; k < 4; ++k) {
-    BodyDef b;
-    b.name = "falling" + std::to_string(k);
-    b.position = k == 0 ? Vec3(0.3, 1.9, 0.1) : Vec3(0.2 * k - 0.4, 1.2 + 2.0 * k, -0.1 * k);
-    b.orientation = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
-    b.velocity = {0, -speed, 0};
-    b.angular_velocity = {spin, 0.3 * spin, -0.5 * spin};
-    s.bodies.push_back(b);
-  }
-  return s;
-}
-
 /// Deepest overlap (m) of any two boxes, or of a box in the floor.
 double deepest(const World& w) {
   double d = 0.0;
@@ -100,8 +79,8 @@ double deepest(const World& w) {
 
 TEST(MaxOverlap, FallingBoxesNeverSinkDeeperThanTheBound) {
   for (const auto& [speed, spin] : {std::pair{10.0, 10.0}, {20.0, 0.0}, {10.0, 30.0}}) {
-    World plain(falling_boxes(speed, spin, 0.0));
-    World bounded(falling_boxes(speed, spin, 0.01));
+    World plain(testing::falling_boxes(speed, spin, 0.0));
+    World bounded(testing::falling_boxes(speed, spin, 0.01));
     double plain_deepest = 0.0;
     std::uint64_t passes = 0, halved = 0, impacts = 0;
     for (int i = 0; i < 120; ++i) {

@@ -66,6 +66,46 @@ TEST(Pipeline, StepAllocatesNothingOnceWarm) {
   EXPECT_GT(world.last_step().contacts, 100u);
 }
 
+// Throws each falling box of testing::falling_boxes up with a spin, aimed to come down on the
+// base box at 12 m/s about 2.4 s later.
+void throw_onto_base(World& world) {
+  const double flight = 2 * 12.0 / 9.81;
+  const Vec3 base = world.body(0).s.x;
+  for (BodyId id = 1; id < world.bodies().size(); ++id) {
+    const Body& b = world.body(id);
+    const Vec3 aim(base.x() + 0.1 * id - 0.25, 0.0, base.z() + 0.05 * id);
+    const Vec3 v((aim.x() - b.s.x.x()) / flight, 12.0, (aim.z() - b.s.x.z()) / flight);
+    world.apply_impulse(id, b.c.mass * v - b.s.P);
+    const Vec3 twist(0.5 * id, 0.0, 0.3);  // a couple: spin without a push
+    world.apply_impulse(id, twist, b.s.x + Vec3(0.0, 0.3, 0.0));
+    world.apply_impulse(id, -twist, b.s.x);
+  }
+}
+
+// A pass taken again in halves (WorldDef::max_overlap) allocates nothing once warm: one
+// snapshot serves every level of halving and grows as the contact cache it copies grew. Boxes
+// are thrown onto a base box again and again, and after four throws the steps that halve must
+// not allocate. (Other steps may still grow a buffer: each landing is a new draw.) Five
+// snapshots, one per level, each grown only to the size it copied, allocated in such steps.
+TEST(Pipeline, PassesTakenAgainAllocateNothingOnceWarm) {
+  if (!kCountsAllocations) GTEST_SKIP() << "ThreadSanitizer owns operator new in this build";
+  World world(testing::falling_boxes(10.0, 10.0, 0.01));
+  int halving_steps = 0;
+  long halving_allocations = 0;
+  for (int cycle = 0; cycle < 16; ++cycle) {
+    for (int i = 0; i < 240; ++i) {
+      const long before = g_allocations.load();
+      world.step();
+      if (cycle < 4 || world.last_step().halved_passes == 0) continue;
+      ++halving_steps;
+      halving_allocations += g_allocations.load() - before;
+    }
+    throw_onto_base(world);
+  }
+  EXPECT_GE(halving_steps, 5);  // 13 with GCC here
+  EXPECT_EQ(halving_allocations, 0);
+}
+
 TEST(Pipeline, StageTimesOnlyWhenAskedFor) {
   World world(bundled("pyramid"));
   world.step();

@@ -17,4 +17,25 @@ inline World world_from_json(const std::string& text) {
 /// A bundled scene with one setting changed.
 inline Scene bundled(const std::string& name) { return load_scene(name); }
 
+/// Four spinning boxes fall at `speed` onto one that rests on the floor (dt = 1/60).
+inline Scene falling_boxes(double speed, double spin, double max_overlap) {
+  Scene s;
+  s.world.max_overlap = max_overlap;
+  s.world.floor = Floor{0.0, 0.0, 0.5};
+  BodyDef base;
+  base.name = "base";
+  base.position = {0, 0.5, 0};
+  s.bodies.push_back(base);
+  for (int k = 0; k < 4; ++k) {
+    BodyDef b;
+    b.name = "falling" + std::to_string(k);
+    b.position = k == 0 ? Vec3(0.3, 1.9, 0.1) : Vec3(0.2 * k - 0.4, 1.2 + 2.0 * k, -0.1 * k);
+    b.orientation = Quat(Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()));
+    b.velocity = {0, -speed, 0};
+    b.angular_velocity = {spin, 0.3 * spin, -0.5 * spin};
+    s.bodies.push_back(b);
+  }
+  return s;
+}
+
 }  // namespace tumble::testing

@@ -31,8 +31,6 @@ struct BroadPhaseCache;
 /// Per-step buffers of the stages.
 struct StepScratch;
 /// What a step keeps to take a pass again (WorldDef::max_overlap).
-struct PassSnapshots;
-/// One of them.
 struct PassSnapshot;
 /// Worker threads of the stages.
 class WorkerPool;
@@ -164,7 +162,7 @@ class World {
   std::unique_ptr<BroadPhaseCache> broad_;   // sweep orders, fat boxes (acceleration only)
   std::unique_ptr<StepScratch> scratch_;     // per-step buffers
   std::unique_ptr<WorkerPool> pool_;         // threads of the stages (never copied)
-  std::unique_ptr<PassSnapshots> snapshots_; // for max_overlap, made at its first use
+  std::unique_ptr<PassSnapshot> snapshot_;   // for max_overlap, made at its first use
 };
 
 }  // namespace tumble
