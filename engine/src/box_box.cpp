@@ -1,5 +1,7 @@
 #include "box_box.hpp"
 
+#include "box_distance.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -169,74 +171,38 @@ int reduce_to_four(const std::array<ManifoldPoint, kMaxClipped>& in, int n, cons
 bool edge_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                   const BodyConstants& cb, int edge_i, int edge_j, const Vec3& axis,
                   BoxManifold& m) {
-  const Vec3& ha = ca.half_extents;
-  const Vec3& hb = cb.half_extents;
   Vec3 n = axis;
   if (n.dot(b.x - a.x) < 0.0) n = -n;
-  // The edge of A farthest along n and the edge of B farthest along −n.
-  Vec3 pa = a.x, pb = b.x;
-  std::uint32_t signs = 0;
-  for (int k = 0; k < 3; ++k) {
-    if (k != edge_i) {
-      const double s = a.R.col(k).dot(n) > 0.0 ? 1.0 : -1.0;
-      pa += s * ha(k) * a.R.col(k);
-      signs |= (s > 0.0 ? 1u : 0u) << k;
-    }
-    if (k != edge_j) {
-      const double s = b.R.col(k).dot(n) < 0.0 ? 1.0 : -1.0;
-      pb += s * hb(k) * b.R.col(k);
-      signs |= (s > 0.0 ? 1u : 0u) << (3 + k);
-    }
-  }
-  // Closest points of the lines pa + s u and pb + t w (Ericson §5.1.8).
-  const Vec3 u = a.R.col(edge_i), w = b.R.col(edge_j);
-  const Vec3 r = pa - pb;
-  const double uw = u.dot(w), ur = u.dot(r), wr = w.dot(r);
-  const double denom = 1.0 - uw * uw;
-  if (denom <= 1e-12) return false;
-  const double s = (uw * wr - ur) / denom;
-  const double t = wr + s * uw;
-  if (std::abs(s) > ha(edge_i) || std::abs(t) > hb(edge_j)) return false;
-  const Vec3 qa = pa + s * u, qb = pb + t * w;
+  EdgeNearest e;
+  if (!extreme_edges_nearest(a, ca.half_extents, edge_i, b, cb.half_extents, edge_j, n, e))
+    return false;
   m.normal = n;
   m.count = 1;
-  m.points[0].position = 0.5 * (qa + qb);
-  m.points[0].separation = (qb - qa).dot(n);
-  m.points[0].id = (1u << 31) | (static_cast<std::uint32_t>(edge_i * 3 + edge_j) << 8) | signs;
+  m.points[0].position = 0.5 * (e.on_a + e.on_b);
+  m.points[0].separation = (e.on_b - e.on_a).dot(n);
+  m.points[0].id = (1u << 31) | (static_cast<std::uint32_t>(edge_i * 3 + edge_j) << 8) | e.corners;
   return true;
-}
-
-/// The point of box (s, c) nearest to p (p itself when inside).
-Vec3 nearest_on_box(const BodyState& s, const BodyConstants& c, const Vec3& p) {
-  const Vec3 local = s.R.transpose() * (p - s.x);
-  return s.x + s.R * local.cwiseMax(-c.half_extents).cwiseMin(c.half_extents);
 }
 
 // kNearestPointsId: box–box ids set bit 31 for an edge pair and bits 12–15 for a face.
 constexpr std::uint32_t kNearestPointsId = 1u << 30;
-constexpr int kNearestPointsRounds = 16;
 
 /// The manifold when no axis separates boxes a and b by the margin but the reference face's
 /// clipping keeps no point: two corners, or a corner and an edge, nearest each other beside
 /// the reference face, where no separating axis points along the gap. One point along the
-/// line between the boxes' nearest points, whose separation along that line is their
-/// distance, when they are apart by less than the margin (else nothing). Without it a cube
-/// flying corner first at another's corner at 40 m/s got no contact until it was 23 cm inside.
+/// line between the boxes' nearest points, whose separation is their distance, when they are
+/// apart (`apart`: some axis separates them) by less than the margin (else nothing). Without
+/// it a cube flying corner first at another's corner at 40 m/s got no contact until it was
+/// 23 cm inside.
 void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                            const BodyConstants& cb, double margin, BoxManifold& m) {
-  const auto [pa, pb] = near_points(a, ca, b, cb, kNearestPointsRounds);
-  const Vec3 line = pb - pa;
-  const double length = line.norm();
-  if (!(length > 0.0)) return;  // overlapping: the projections met inside both boxes
-  const Vec3 n = line / length;
-  const double separation = separation_along(a, ca, b, cb, n);
-  // Only apart, a gap the line measures: boxes that overlap (their projections stopped short
-  // of meeting inside both) leave `line` round-off small and its direction meaningless.
-  if (!(separation > 0.0 && separation < margin)) return;
-  m.normal = n;
+                            const BodyConstants& cb, double margin, bool apart, BoxManifold& m) {
+  if (!apart) return;  // overlapping: no line between the boxes
+  const BoxNearest near = box_nearest(a, ca, b, cb);
+  if (!(near.distance > 0.0 && near.distance < margin)) return;
+  m.normal = (near.on_b - near.on_a) / near.distance;
   m.count = 1;
-  m.points[0].position = 0.5 * (pa + pb);
-  m.points[0].separation = separation;
+  m.points[0].position = 0.5 * (near.on_a + near.on_b);
+  m.points[0].separation = near.distance;
   m.points[0].id = kNearestPointsId;
 }
 
@@ -322,7 +288,8 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
     m.normal = n_ref;
   }
   m.count = reduce_to_four(clipped, n, m.normal, m.points);
-  if (m.count == 0) nearest_points_contact(a, ca, b, cb, margin, m);
+  if (m.count == 0)
+    nearest_points_contact(a, ca, b, cb, margin, std::max(best_face, best_edge) > 0.0, m);
   return m;
 }
 
@@ -332,21 +299,6 @@ double separation_along(const BodyState& a, const BodyConstants& ca, const BodyS
   const double ra = (a.R.transpose() * n).cwiseAbs().dot(ca.half_extents);
   const double rb = (b.R.transpose() * n).cwiseAbs().dot(cb.half_extents);
   return (b.x - a.x).dot(n) - ra - rb;
-}
-
-std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                                  const BodyConstants& cb, int rounds) {
-  Vec3 pa = nearest_on_box(a, ca, b.x);
-  Vec3 pb = nearest_on_box(b, cb, pa);
-  for (int i = 0; i < rounds; ++i) {
-    const Vec3 qa = nearest_on_box(a, ca, pb);
-    const Vec3 qb = nearest_on_box(b, cb, qa);
-    const double moved = (qa - pa).squaredNorm() + (qb - pb).squaredNorm();
-    pa = qa;
-    pb = qb;
-    if (moved < 1e-18) break;
-  }
-  return {pa, pb};
 }
 
 // The same 15 axes as collide_boxes, in a's frame (Ericson, Real-Time Collision Detection,

@@ -39,13 +39,6 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
 double separation_along(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                         const BodyConstants& cb, const Vec3& n);
 
-/// Points of boxes a and b (world, m) near each other: alternating projections from b's centre,
-/// each the nearest point of one box to the other's last (Cheney & Goldstein 1959: they approach
-/// the nearest pair of two disjoint convex sets), `rounds` rounds or until they move less than
-/// 1e-9 m.
-std::pair<Vec3, Vec3> near_points(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                                  const BodyConstants& cb, int rounds);
-
 /// Penetration depth of boxes a and b, m (≤ 0 when they are apart): the least overlap of their
 /// projections over the 15 separating axes, which for two boxes is the shortest translation
 /// that separates them. Returns as soon as one axis shows the depth is at most `enough`, with
