@@ -14,20 +14,31 @@ void keep_closer(const Vec3& p, const Vec3& q, BoxNearest& best, double& best_sq
   best.on_b = q;
 }
 
-/// Each corner of box `from` against the nearest point of box `to` (the corner clamped into
-/// `to`'s extents in its frame); `flip` when `from` is box b.
+/// Each corner of box `from` against the nearest point of box `to`: the corner clamped into
+/// `to`'s extents, in `to`'s frame (where the corners are the centre plus or minus the three
+/// half axes, and distances are the world's); `flip` when `from` is box b.
 void corners_against(const BodyState& from, const Vec3& from_half, const BodyState& to,
                      const Vec3& to_half, bool flip, BoxNearest& best, double& best_squared) {
+  const Mat3 axes = to.R.transpose() * from.R;
+  const Vec3 centre = to.R.transpose() * (from.x - to.x);
+  const Vec3 e0 = from_half.x() * axes.col(0), e1 = from_half.y() * axes.col(1),
+             e2 = from_half.z() * axes.col(2);
+  int nearest = -1;
+  Vec3 corner, clamped;
   for (int k = 0; k < 8; ++k) {
-    const Vec3 corner_local((k & 1) ? from_half.x() : -from_half.x(),
-                            (k & 2) ? from_half.y() : -from_half.y(),
-                            (k & 4) ? from_half.z() : -from_half.z());
-    const Vec3 corner = from.x + from.R * corner_local;
-    const Vec3 in_to = to.R.transpose() * (corner - to.x);
-    const Vec3 nearest = to.x + to.R * in_to.cwiseMax(-to_half).cwiseMin(to_half);
-    if (flip) keep_closer(nearest, corner, best, best_squared);
-    else keep_closer(corner, nearest, best, best_squared);
+    const Vec3 c = centre + ((k & 1) ? e0 : -e0) + ((k & 2) ? e1 : -e1) + ((k & 4) ? e2 : -e2);
+    const Vec3 q = c.cwiseMax(-to_half).cwiseMin(to_half);
+    const double squared = (c - q).squaredNorm();
+    if (squared >= best_squared) continue;
+    best_squared = squared;
+    nearest = k;
+    corner = c;
+    clamped = q;
   }
+  if (nearest < 0) return;
+  const Vec3 on_from = to.x + to.R * corner, on_to = to.x + to.R * clamped;
+  best.on_a = flip ? on_to : on_from;
+  best.on_b = flip ? on_from : on_to;
 }
 
 /// For each of the nine edge directions a_i × b_j: the extreme edges' nearest points.
