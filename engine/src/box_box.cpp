@@ -218,7 +218,7 @@ void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const B
 // closest points of the two edges. Separations are signed, so the same test yields
 // speculative points for boxes up to `margin` apart.
 BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                          const BodyConstants& cb, double margin) {
+                          const BodyConstants& cb, double margin, double wanted) {
   BoxManifold m;
   const Vec3 d = b.x - a.x;
   const Mat3 C = a.R.transpose() * b.R;  // C(i,j) = a_i · b_j
@@ -270,9 +270,15 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
   }
   m = BoxManifold{};
 
+  // A clipped point lies on the incident face, so its separation along the reference normal
+  // is at least that axis's separation (the least over the incident box's corners); the
+  // nearest points' contact, taken when the clipping keeps none, is the boxes' distance, which
+  // no axis's separation exceeds.
+  const bool on_b = best_b > best_a + kFaceTolerance;
+  if ((on_b ? best_b : best_a) > wanted) return m;
   std::array<ManifoldPoint, kMaxClipped> clipped{};
   int n = 0;
-  if (best_b > best_a + kFaceTolerance) {
+  if (on_b) {
     // Reference face on B; its normal points from B to A, the manifold normal is its opposite.
     const double sign = db(axis_b) > 0.0 ? -1.0 : 1.0;
     const Vec3 n_ref = sign * b.R.col(axis_b);

@@ -3,6 +3,7 @@
 /// manifold of up to 4 points with feature ids (so impulses persist between steps).
 /// Pure functions; thread-safe.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 
@@ -29,9 +30,11 @@ struct BoxManifold {
 
 /// The manifold of boxes a and b, keeping points whose separation is below `margin` (m, ≥ 0:
 /// speculative points closer than the margin are kept so the solver can stop an approach
-/// before it penetrates). count == 0 when the boxes are farther apart than the margin.
+/// before it penetrates). count == 0 when the boxes are farther apart than the margin, or when
+/// the face that would be clipped shows them more than `wanted` (m) apart: every point of the
+/// manifold would be at least that far apart, and the caller keeps none of them.
 BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                          const BodyConstants& cb, double margin);
+                          const BodyConstants& cb, double margin, double wanted = INFINITY);
 
 /// Separation of boxes a and b along the unit axis n (world), m: how far b's projection on n
 /// lies beyond a's (negative where they overlap). A lower bound on the boxes' distance for

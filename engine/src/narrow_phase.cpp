@@ -36,6 +36,16 @@ bool touches(const BoxManifold& m, const Body& a, const Motion& ma, const Body& 
   return false;
 }
 
+/// A separation (m) past which no point of a manifold kept within `margin` passes touches():
+/// such a point lies within half its separation of both boxes' surfaces, so its normal speed
+/// is at most |v_a − v_b| + |ω_a| (r_a + margin / 2) + |ω_b| (r_b + margin / 2), which over dt
+/// is `closing` and the margin's part. collide_boxes then skips the faces' clipping.
+double touch_limit(const Motion& ma, const Motion& mb, double closing, double margin,
+                   double dt) {
+  constexpr double kRoundOff = 1e-9;  // m: far above the clipping's rounding
+  return kTouchDistance + closing + 0.5 * margin * dt * (ma.w.norm() + mb.w.norm()) + kRoundOff;
+}
+
 /// Writes the contact of manifold m between bodies a and b into c (its points past m.count
 /// are left as they were: nothing reads them).
 void write_contact(const BoxManifold& m, std::uint32_t a, std::uint32_t b, const Body& ba,
@@ -74,7 +84,8 @@ BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared,
   const double margin = kSpeculativeDistance + closing;
   const double reach = a.c.bounding_radius + b.c.bounding_radius + margin;
   if ((b.s.x - a.s.x).squaredNorm() > reach * reach) return {};
-  BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, margin);
+  BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, margin,
+                                touch_limit(ma, mb, closing, margin, ctx.dt));
   if (m.count > 0 && !touches(m, a, ma, b, mb, ctx.dt)) m.count = 0;
   return m;
 }
