@@ -101,6 +101,42 @@ TEST(BoxDistance, IsTheLeastDistanceBetweenTheBoxes) {
   EXPECT_GT(tested, 1000);
 }
 
+// collide_boxes skips the faces' clipping where the reference face shows the boxes farther
+// apart than the caller wants (`wanted`, narrow_phase.cpp's touch_limit): exact only while no
+// point of the full manifold is nearer than that face's separation, which the nearest points'
+// contact (the boxes' distance) keeps too. Pairs a few centimetres apart, corners and edges
+// beside each other's faces among them.
+TEST(BoxDistance, NoManifoldPointIsNearerThanTheSkipAssumes) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), half(0.1, 0.6), wanted(0.0, 0.05);
+  auto rotation = [&] {
+    return Quat(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized())
+        .toRotationMatrix();
+  };
+  int skipped = 0;
+  for (int k = 0; k < 20000; ++k) {
+    const BodyConstants ca = box(Vec3(half(rng), half(rng), half(rng)));
+    const BodyConstants cb = box(Vec3(half(rng), half(rng), half(rng)));
+    const BodyState a = pose(Vec3::Zero(), rotation());
+    const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    BodyState b = pose(Vec3::Zero(), rotation());
+    // Slide b out along dir until the boxes are apart, then a random gap up to 5 cm further.
+    double lo = 0.0, hi = 2.0 * (ca.half_extents.norm() + cb.half_extents.norm());
+    for (int i = 0; i < 50; ++i) {
+      b.x = 0.5 * (lo + hi) * dir;
+      (box_depth(a, ca, b, cb, -INFINITY) > 0.0 ? lo : hi) = 0.5 * (lo + hi);
+    }
+    b.x = (hi + 0.05 * (0.5 + 0.5 * unit(rng))) * dir;
+    const double limit = wanted(rng);
+    const BoxManifold full = collide_boxes(a, ca, b, cb, 0.1);
+    if (full.count == 0 || collide_boxes(a, ca, b, cb, 0.1, limit).count > 0) continue;
+    ++skipped;
+    for (int i = 0; i < full.count; ++i)
+      ASSERT_GT(full.points[i].separation, limit - 1e-12) << k << " point " << i;
+  }
+  EXPECT_GT(skipped, 1000);
+}
+
 // Two boxes of `pile` at step ~400, each beside the other's faces: no face clipping keeps a
 // point, so the narrow phase takes the line between their nearest points. Alternating
 // projections between the boxes (16 rounds) put that contact 11.5 mm apart, where a face axis
