@@ -12,12 +12,7 @@
 namespace tumble {
 namespace {
 
-BodyState pose(const Vec3& x, const Mat3& R) {
-  BodyState s;
-  s.x = x;
-  s.R = R;
-  return s;
-}
+using testing::pose;
 
 BodyConstants box(const Vec3& half) {
   BodyConstants c;
@@ -71,6 +66,13 @@ double brute_distance(const BodyState& a, const Vec3& ha, const BodyState& b, co
   return d;
 }
 
+/// A rotation drawn from a uniform quaternion direction.
+Mat3 random_rotation(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  return Quat(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized())
+      .toRotationMatrix();
+}
+
 bool inside(const Vec3& p, const BodyState& s, const Vec3& h) {
   const Vec3 local = s.R.transpose() * (p - s.x);
   return (local.cwiseAbs() - h).maxCoeff() <= 1e-12;
@@ -79,16 +81,12 @@ bool inside(const Vec3& p, const BodyState& s, const Vec3& h) {
 TEST(BoxDistance, IsTheLeastDistanceBetweenTheBoxes) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), half(0.1, 0.6), apart(0.3, 1.3);
-  auto rotation = [&] {
-    return Quat(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized())
-        .toRotationMatrix();
-  };
   int tested = 0;
   for (int k = 0; k < 3000; ++k) {
     const Vec3 ha(half(rng), half(rng), half(rng)), hb(half(rng), half(rng), half(rng));
-    const BodyState a = pose(Vec3(unit(rng), unit(rng), unit(rng)), rotation());
+    const BodyState a = pose(Vec3(unit(rng), unit(rng), unit(rng)), random_rotation(rng));
     const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
-    const BodyState b = pose(a.x + apart(rng) * (ha.norm() + hb.norm()) * dir, rotation());
+    const BodyState b = pose(a.x + apart(rng) * (ha.norm() + hb.norm()) * dir, random_rotation(rng));
     if (box_depth(a, box(ha), b, box(hb), -INFINITY) >= 0.0) continue;  // they overlap
     ++tested;
     const BoxNearest near = box_nearest(a, box(ha), b, box(hb));
@@ -109,17 +107,13 @@ TEST(BoxDistance, IsTheLeastDistanceBetweenTheBoxes) {
 TEST(BoxDistance, NoManifoldPointIsNearerThanTheSkipAssumes) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), half(0.1, 0.6), wanted(0.0, 0.05);
-  auto rotation = [&] {
-    return Quat(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized())
-        .toRotationMatrix();
-  };
   int skipped = 0;
   for (int k = 0; k < 20000; ++k) {
     const BodyConstants ca = box(Vec3(half(rng), half(rng), half(rng)));
     const BodyConstants cb = box(Vec3(half(rng), half(rng), half(rng)));
-    const BodyState a = pose(Vec3::Zero(), rotation());
+    const BodyState a = pose(Vec3::Zero(), random_rotation(rng));
     const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
-    BodyState b = pose(Vec3::Zero(), rotation());
+    BodyState b = pose(Vec3::Zero(), random_rotation(rng));
     // Slide b out along dir until the boxes are apart, then a random gap up to 5 cm further.
     double lo = 0.0, hi = 2.0 * (ca.half_extents.norm() + cb.half_extents.norm());
     for (int i = 0; i < 50; ++i) {

@@ -4,16 +4,12 @@
 
 #include "box_box.hpp"
 #include "manifold_record.hpp"
+#include "world_fixture.hpp"
 
 namespace tumble {
 namespace {
 
-BodyState pose(const Vec3& x, const Mat3& R) {
-  BodyState s;
-  s.x = x;
-  s.R = R;
-  return s;
-}
+using testing::pose;
 
 /// A pose of b resting on a's top face, in a's frame moved to world by (Ra, xa), with b's
 /// offset (in a's frame) and turn about a's normal.

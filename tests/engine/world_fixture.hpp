@@ -14,6 +14,14 @@ inline World world_from_json(const std::string& text) {
   return World(scene_from_json(nlohmann::json::parse(text)));
 }
 
+/// A body state at centre x (m) turned by R, at rest.
+inline BodyState pose(const Vec3& x, const Mat3& R) {
+  BodyState s;
+  s.x = x;
+  s.R = R;
+  return s;
+}
+
 /// A bundled scene with one setting changed.
 inline Scene bundled(const std::string& name) { return load_scene(name); }
 
