@@ -299,14 +299,6 @@ BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const Bod
   return m;
 }
 
-double separation_along(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                        const BodyConstants& cb, const Vec3& n) {
-  // Each box's half width along n: Σ_k h_k |R_k · n|.
-  const double ra = (a.R.transpose() * n).cwiseAbs().dot(ca.half_extents);
-  const double rb = (b.R.transpose() * n).cwiseAbs().dot(cb.half_extents);
-  return (b.x - a.x).dot(n) - ra - rb;
-}
-
 // The same 15 axes as collide_boxes, in a's frame (Ericson, Real-Time Collision Detection,
 // §4.4.1): C = R_aᵀ R_b holds the cosines between the two boxes' axes and t the centres'
 // offset, so each axis's overlap is a few products. An edge axis a_i × b_j has length

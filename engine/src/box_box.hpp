@@ -5,7 +5,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <utility>
 
 #include "tumble/body.hpp"
 
@@ -35,12 +34,6 @@ struct BoxManifold {
 /// manifold would be at least that far apart, and the caller keeps none of them.
 BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                           const BodyConstants& cb, double margin, double wanted = INFINITY);
-
-/// Separation of boxes a and b along the unit axis n (world), m: how far b's projection on n
-/// lies beyond a's (negative where they overlap). A lower bound on the boxes' distance for
-/// every n, equal to it along the line between their nearest points.
-double separation_along(const BodyState& a, const BodyConstants& ca, const BodyState& b,
-                        const BodyConstants& cb, const Vec3& n);
 
 /// Penetration depth of boxes a and b, m (≤ 0 when they are apart): the least overlap of their
 /// projections over the 15 separating axes, which for two boxes is the shortest translation

@@ -8,6 +8,7 @@
 
 #include "../sanitized.hpp"
 #include "box_box.hpp"
+#include "box_distance.hpp"
 #include "world_fixture.hpp"
 
 namespace tumble {
@@ -91,7 +92,7 @@ TEST(BoxBox, CornersBesideTheFacesMeetAlongTheirGap) {
   EXPECT_LT((m.normal - Vec3::UnitX()).norm(), 1e-12);
   EXPECT_NEAR(m.points[0].separation, gap, 1e-12);
   EXPECT_LT((m.points[0].position - Vec3(0.5 * d, 0, 0)).norm(), 1e-12);
-  EXPECT_NEAR(separation_along(at({0, 0, 0}, R), c, at({d, 0, 0}, R), c, Vec3::UnitX()), gap, 1e-12);
+  EXPECT_NEAR(box_nearest(at({0, 0, 0}, R), c, at({d, 0, 0}, R), c).distance, gap, 1e-12);
   // Beyond the margin: nothing.
   EXPECT_EQ(collide_boxes(at({0, 0, 0}, R), c, at({d + 0.2, 0, 0}, R), c, 0.3).count, 0);
 }
