@@ -16,7 +16,8 @@ struct Spec {
   std::string label;
   std::function<tumble::Scene()> build;
   long steps;
-  bool keep_awake;  // a zero impulse on every body every 15 steps, as in `contact`
+  bool keep_awake;       // a zero impulse on every body every 15 steps, as in `contact`
+  unsigned threads = 1;  // World::set_threads
 };
 
 std::vector<Spec> specs(bool quick) {
@@ -25,6 +26,7 @@ std::vector<Spec> specs(bool quick) {
   return {{"tower", [] { return bundled("tower"); }, quick ? 60 : 600, true},
           {"pyramid", [] { return bundled("pyramid"); }, quick ? 10 : 60, true},
           {"pile", [] { return bundled("pile"); }, quick ? 10 : 120, true},
+          {"pile (two threads)", [] { return bundled("pile"); }, quick ? 10 : 120, true, 2},
           {"throughput" + cubes,
            [n] { return separated_boxes(n, 1.0 / 240.0, 42, BoxShape::cube); },
            quick ? 60 : 480, false},
@@ -40,6 +42,7 @@ struct Totals {
 
 Totals run_once(const Spec& spec, const tumble::Scene& scene) {
   tumble::World w(scene);
+  w.set_threads(spec.threads);
   w.set_stage_timing(true);  // off by default: two clock reads per stage
   Totals t;
   for (long i = 1; i <= spec.steps; ++i) {
