@@ -40,10 +40,10 @@ bool touches(const BoxManifold& m, const Body& a, const Motion& ma, const Body& 
 /// such a point lies within half its separation of both boxes' surfaces, so its normal speed
 /// is at most |v_a − v_b| + |ω_a| (r_a + margin / 2) + |ω_b| (r_b + margin / 2), which over dt
 /// is `closing` and the margin's part. collide_boxes then skips the faces' clipping.
-double touch_limit(const Motion& ma, const Motion& mb, double closing, double margin,
-                   double dt) {
+/// `spins`: |ω_a| + |ω_b|, rad/s.
+double touch_limit(double spins, double closing, double margin, double dt) {
   constexpr double kRoundOff = 1e-9;  // m: far above the clipping's rounding
-  return kTouchDistance + closing + 0.5 * margin * dt * (ma.w.norm() + mb.w.norm()) + kRoundOff;
+  return kTouchDistance + closing + 0.5 * margin * dt * spins + kRoundOff;
 }
 
 /// Writes the contact of manifold m between bodies a and b into c (its points past m.count
@@ -74,8 +74,9 @@ BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared,
   const Body& a = ctx.bodies[p.first];
   const Body& b = ctx.bodies[p.second];
   const Motion ma = motion(ctx, p.first, shared), mb = motion(ctx, p.second, shared);
-  const double closing = ctx.dt * ((ma.v - mb.v).norm() + ma.w.norm() * a.c.bounding_radius +
-                                   mb.w.norm() * b.c.bounding_radius);
+  const double spin_a = ma.w.norm(), spin_b = mb.w.norm();
+  const double closing = ctx.dt * ((ma.v - mb.v).norm() + spin_a * a.c.bounding_radius +
+                                   spin_b * b.c.bounding_radius);
   recordable = closing < kRecycleDistance;
   // Bounding spheres farther apart than the margin: the boxes are too, and stay more than the
   // speculative distance apart over the step, so nothing the full test could keep touches.
@@ -85,7 +86,7 @@ BoxManifold manifold_of(const StepContext& ctx, const BodyPair& p, bool shared,
   const double reach = a.c.bounding_radius + b.c.bounding_radius + margin;
   if ((b.s.x - a.s.x).squaredNorm() > reach * reach) return {};
   BoxManifold m = collide_boxes(a.s, a.c, b.s, b.c, margin,
-                                touch_limit(ma, mb, closing, margin, ctx.dt));
+                                touch_limit(spin_a + spin_b, closing, margin, ctx.dt));
   if (m.count > 0 && !touches(m, a, ma, b, mb, ctx.dt)) m.count = 0;
   return m;
 }
