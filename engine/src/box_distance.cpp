@@ -100,7 +100,7 @@ bool extreme_edges_nearest(const BodyState& a, const Vec3& ha, int i, const Body
 // so the least of the 16 corners and the 9 edge pairs is the distance itself (a few hundred
 // flops). Alternating projections between the boxes (Cheney & Goldstein 1959), used before,
 // converge slowly where a corner lies beside a tilted face: in `pile` they left gaps up to
-// 3.3 cm short after 16 rounds and 0.9 cm after 256 (docs/engine.md).
+// 3.3 cm short after 16 rounds and 0.9 cm after 256 (docs/engine-log.md).
 BoxNearest box_nearest(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                        const BodyConstants& cb) {
   BoxNearest best;

@@ -61,7 +61,7 @@ void sweep_in_order(std::span<Contact> contacts, Fn&& fn, int passes, bool first
 /// level a sweep. One backward pass first hands the loads down the stacks once; the forward
 /// passes then carry the support back up. It is symmetric Gauss–Seidel's first half only:
 /// alternating every pass undid part of each forward pass's support, and a tower's floor load
-/// converged more slowly (docs/engine.md, "Sweeps both ways"). With it ten sweeps hold the
+/// converged more slowly (docs/engine-log.md, "Sweeps both ways"). With it ten sweeps hold the
 /// 5,050-box pyramid better than twelve forward did (top box 1.05 mm against 1.93 mm); nine
 /// let it fall.
 template <typename Fn>

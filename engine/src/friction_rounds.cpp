@@ -18,7 +18,7 @@ RoundOutput FrictionRounds::operator()(const RoundInput& in) const {
 // resolve then goes on with plain rounds, which creep in, and `best` keeps whichever round
 // came closest.
 // Measured on the 3,000 sliding edges of the friction tests and a 1,000-cube landing at
-// μ = 1 (docs/engine.md, "What changed").
+// μ = 1 (docs/engine-log.md, "What changed").
 void polish(const FrictionRounds& rounds, double lever, ClosestRound& best) {
   constexpr int kSteps = 3;      // Newton steps at most
   constexpr int kHalvings = 4;   // tries of each step, halved each time

@@ -20,7 +20,7 @@ namespace tumble {
 // the recorded ones (on unit boxes, a thousandth of the face), and a feature that was
 // farther than the speculative margin (2 cm) when recorded is still over 1.9 cm away, out of
 // reach of a pair moving under 1 mm a step. Measured (callgrind, `pyramid`'s 30 timed steps,
-// and the stacks' probe of docs/engine.md): 1e-5 m recycled 30 % of `pyramid`'s manifolds
+// and the stacks' probe of docs/engine-log.md): 1e-5 m recycled 30 % of `pyramid`'s manifolds
 // for 1.2 % fewer instructions in `World::step`, 1e-4 m 6.3 %, 1e-3 m 7.5 %, with the same
 // deepest overlaps, top-box travel and sleep times to two digits.
 inline constexpr double kRecycleDistance = 1e-3;
