@@ -206,6 +206,108 @@ void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const B
   m.points[0].id = kNearestPointsId;
 }
 
+/// Boxes a and b in a's frame: C(i, j) = a_i · b_j, |C| (plus ε, which keeps near-parallel
+/// edge pairs from producing a false separating axis: Gottschalk) and the centres' offset
+/// b.x − a.x in each box's own frame.
+struct PairFrame {
+  Mat3 C, absC;
+  Vec3 da, db;
+};
+
+PairFrame pair_frame(const BodyState& a, const BodyState& b) {
+  const Vec3 d = b.x - a.x;
+  PairFrame f;
+  f.C = a.R.transpose() * b.R;
+  f.absC = f.C.cwiseAbs().array() + 1e-12;
+  f.da = a.R.transpose() * d;
+  f.db = b.R.transpose() * d;
+  return f;
+}
+
+/// The largest separation along one box's face normals (m) and which normal gave it.
+struct AxisSeparation {
+  double separation = -INFINITY;
+  int axis = -1;
+};
+
+/// The face axes of A, then of B: false as soon as one separates the boxes by more than
+/// `margin`, else the best of each.
+bool face_axes(const PairFrame& f, const Vec3& ha, const Vec3& hb, double margin,
+               AxisSeparation& on_a, AxisSeparation& on_b) {
+  double best_a = -INFINITY, best_b = -INFINITY;
+  int axis_a = 0, axis_b = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double s = std::abs(f.da(i)) - (ha(i) + f.absC.row(i).dot(hb));
+    if (s > margin) return false;
+    if (s > best_a) best_a = s, axis_a = i;
+  }
+  for (int j = 0; j < 3; ++j) {
+    const double s = std::abs(f.db(j)) - (f.absC.col(j).dot(ha) + hb(j));
+    if (s > margin) return false;
+    if (s > best_b) best_b = s, axis_b = j;
+  }
+  on_a = {best_a, axis_a};
+  on_b = {best_b, axis_b};
+  return true;
+}
+
+/// The nine edge axes a_i × b_j from C alone (Ericson §4.4.1): in A's frame the axis is
+/// e_i × C(:, j), whose components i1, i2 are −C(i2, j) and C(i1, j), so its length, the
+/// projection of d and both boxes' radii along it are a few products of C's entries. False as
+/// soon as one separates the boxes by more than `margin`; else the best (axis = 3 i + j, or −1
+/// when every pair of edges is parallel).
+bool edge_axes(const PairFrame& f, const Vec3& ha, const Vec3& hb, double margin,
+               AxisSeparation& best) {
+  double most = -INFINITY;
+  int axis = -1;
+  const Mat3& C = f.C;
+  const Mat3& absC = f.absC;
+  for (int i = 0; i < 3; ++i) {
+    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+    for (int j = 0; j < 3; ++j) {
+      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+      const double len = std::sqrt(C(i1, j) * C(i1, j) + C(i2, j) * C(i2, j));
+      if (len < 1e-6) continue;  // parallel edges: covered by the face axes
+      const double ra = ha(i1) * absC(i2, j) + ha(i2) * absC(i1, j);
+      const double rb = hb(j1) * absC(i, j2) + hb(j2) * absC(i, j1);
+      const double s = (std::abs(f.da(i2) * C(i1, j) - f.da(i1) * C(i2, j)) - (ra + rb)) / len;
+      if (s > margin) return false;
+      if (s > most) most = s, axis = 3 * i + j;
+    }
+  }
+  best = {most, axis};
+  return true;
+}
+
+/// The face case: the incident face clipped against the reference face, on A's face axis or
+/// on B's when it separates the boxes clearly more; at most four points kept. The normal
+/// points from A to B.
+BoxManifold face_manifold(const BodyState& a, const BodyConstants& ca, const BodyState& b,
+                          const BodyConstants& cb, const PairFrame& f, bool on_b,
+                          const AxisSeparation& face, double margin) {
+  BoxManifold m;
+  std::array<ManifoldPoint, kMaxClipped> clipped{};
+  int n = 0;
+  const int axis = face.axis;
+  if (on_b) {
+    // Reference face on B; its normal points from B to A, the manifold normal is its opposite.
+    const double sign = f.db(axis) > 0.0 ? -1.0 : 1.0;
+    const Vec3 n_ref = sign * b.R.col(axis);
+    const std::uint32_t ref_face = static_cast<std::uint32_t>(2 * axis + (sign > 0.0 ? 1 : 0));
+    n = clip_faces(Box{b, cb}, axis, n_ref, Box{a, ca}, margin, (1u << 15) | (ref_face << 12),
+                   clipped);
+    m.normal = -n_ref;
+  } else {
+    const double sign = f.da(axis) > 0.0 ? 1.0 : -1.0;
+    const Vec3 n_ref = sign * a.R.col(axis);
+    const std::uint32_t ref_face = static_cast<std::uint32_t>(2 * axis + (sign > 0.0 ? 1 : 0));
+    n = clip_faces(Box{a, ca}, axis, n_ref, Box{b, cb}, margin, ref_face << 12, clipped);
+    m.normal = n_ref;
+  }
+  m.count = reduce_to_four(clipped, n, m.normal, m.points);
+  return m;
+}
+
 }  // namespace
 
 // Separating-axis test for oriented boxes (Gottschalk, Lin & Manocha, "OBBTree", SIGGRAPH
@@ -219,83 +321,32 @@ void nearest_points_contact(const BodyState& a, const BodyConstants& ca, const B
 // speculative points for boxes up to `margin` apart.
 BoxManifold collide_boxes(const BodyState& a, const BodyConstants& ca, const BodyState& b,
                           const BodyConstants& cb, double margin, double wanted) {
-  BoxManifold m;
-  const Vec3 d = b.x - a.x;
-  const Mat3 C = a.R.transpose() * b.R;  // C(i,j) = a_i · b_j
-  // ε keeps near-parallel edge pairs from producing a false separating axis (Gottschalk).
-  const Mat3 absC = C.cwiseAbs().array() + 1e-12;
-  const Vec3 da = a.R.transpose() * d;
-  const Vec3 db = b.R.transpose() * d;
   const Vec3& ha = ca.half_extents;
   const Vec3& hb = cb.half_extents;
-
-  double best_a = -INFINITY, best_b = -INFINITY;
-  int axis_a = 0, axis_b = 0;
-  for (int i = 0; i < 3; ++i) {
-    const double s = std::abs(da(i)) - (ha(i) + absC.row(i).dot(hb));
-    if (s > margin) return m;
-    if (s > best_a) best_a = s, axis_a = i;
-  }
-  for (int j = 0; j < 3; ++j) {
-    const double s = std::abs(db(j)) - (absC.col(j).dot(ha) + hb(j));
-    if (s > margin) return m;
-    if (s > best_b) best_b = s, axis_b = j;
-  }
-  // The edge axes a_i × b_j from C alone (Ericson §4.4.1): in A's frame the axis is
-  // e_i × C(:, j), whose components i1, i2 are −C(i2, j) and C(i1, j), so its length, the
-  // projection of d and both boxes' radii along it are a few products of C's entries.
-  double best_edge = -INFINITY;
-  int edge_i = -1, edge_j = -1;
-  for (int i = 0; i < 3; ++i) {
-    const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
-    for (int j = 0; j < 3; ++j) {
-      const int j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-      const double len = std::sqrt(C(i1, j) * C(i1, j) + C(i2, j) * C(i2, j));
-      if (len < 1e-6) continue;  // parallel edges: covered by the face axes
-      const double ra = ha(i1) * absC(i2, j) + ha(i2) * absC(i1, j);
-      const double rb = hb(j1) * absC(i, j2) + hb(j2) * absC(i, j1);
-      const double s = (std::abs(da(i2) * C(i1, j) - da(i1) * C(i2, j)) - (ra + rb)) / len;
-      if (s > margin) return m;
-      if (s > best_edge) best_edge = s, edge_i = i, edge_j = j;
-    }
-  }
-
-  const double best_face = std::max(best_a, best_b);
+  const PairFrame f = pair_frame(a, b);
+  AxisSeparation on_a, on_b, edge;
+  if (!face_axes(f, ha, hb, margin, on_a, on_b) || !edge_axes(f, ha, hb, margin, edge))
+    return {};
+  const double best_face = std::max(on_a.separation, on_b.separation);
   const double edge_tolerance =
       kEdgeTolerance + kEdgeRelativeTolerance * std::min(ha.minCoeff(), hb.minCoeff());
-  if (edge_i >= 0 && best_edge > best_face + edge_tolerance) {
+  if (edge.axis >= 0 && edge.separation > best_face + edge_tolerance) {
+    const int edge_i = edge.axis / 3, edge_j = edge.axis % 3;
     const Vec3 axis = a.R.col(edge_i).cross(b.R.col(edge_j)).normalized();
+    BoxManifold m;
     if (edge_contact(a, ca, b, cb, edge_i, edge_j, axis, m) && m.points[0].separation < margin)
       return m;
   }
-  m = BoxManifold{};
-
   // A clipped point lies on the incident face, so its separation along the reference normal
   // is at least that axis's separation (the least over the incident box's corners); the
   // nearest points' contact, taken when the clipping keeps none, is the boxes' distance, which
   // no axis's separation exceeds.
-  const bool on_b = best_b > best_a + kFaceTolerance;
-  if ((on_b ? best_b : best_a) > wanted) return m;
-  std::array<ManifoldPoint, kMaxClipped> clipped{};
-  int n = 0;
-  if (on_b) {
-    // Reference face on B; its normal points from B to A, the manifold normal is its opposite.
-    const double sign = db(axis_b) > 0.0 ? -1.0 : 1.0;
-    const Vec3 n_ref = sign * b.R.col(axis_b);
-    const std::uint32_t ref_face = static_cast<std::uint32_t>(2 * axis_b + (sign > 0.0 ? 1 : 0));
-    n = clip_faces(Box{b, cb}, axis_b, n_ref, Box{a, ca}, margin, (1u << 15) | (ref_face << 12),
-                   clipped);
-    m.normal = -n_ref;
-  } else {
-    const double sign = da(axis_a) > 0.0 ? 1.0 : -1.0;
-    const Vec3 n_ref = sign * a.R.col(axis_a);
-    const std::uint32_t ref_face = static_cast<std::uint32_t>(2 * axis_a + (sign > 0.0 ? 1 : 0));
-    n = clip_faces(Box{a, ca}, axis_a, n_ref, Box{b, cb}, margin, ref_face << 12, clipped);
-    m.normal = n_ref;
-  }
-  m.count = reduce_to_four(clipped, n, m.normal, m.points);
+  const bool use_b = on_b.separation > on_a.separation + kFaceTolerance;
+  const AxisSeparation& face = use_b ? on_b : on_a;
+  if (face.separation > wanted) return {};
+  BoxManifold m = face_manifold(a, ca, b, cb, f, use_b, face, margin);
   if (m.count == 0)
-    nearest_points_contact(a, ca, b, cb, margin, std::max(best_face, best_edge) > 0.0, m);
+    nearest_points_contact(a, ca, b, cb, margin, std::max(best_face, edge.separation) > 0.0, m);
   return m;
 }
 
