@@ -216,21 +216,13 @@ std::size_t sweep_sleeping(const SweepScratch& scratch, std::span<const Aabb> bo
   return tests;
 }
 
-}  // namespace
-
-// Sweep and prune (Baraff 1992, "Dynamic simulation of non-penetrating rigid bodies", §7.4;
-// Ericson, Real-Time Collision Detection, §7.5.1): sort the boxes by where their projection
-// on the sweep direction starts and sweep, testing each box only against those whose
-// interval is still open. Bodies move little between steps, so last step's order is almost
-// sorted and insertion sort is about linear. Sleeping bodies do not move: they are sorted
-// once per change of the sleeping set, and each awake box finds the sleeping ones it may
-// touch by binary search over that list.
-bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
-                std::span<const std::uint8_t> candidate,
-                std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
-                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs,
-                WorkerPool& pool) {
-  pairs.clear();
+/// The awake candidates in sweep order (scratch.awake, scratch.start, scratch.awake_width):
+/// last step's order for the bodies still awake, then the rest appended, sorted again by
+/// insertion (almost sorted: bodies move little between steps) or, after many newcomers (the
+/// first step, a mass wake-up), in full.
+void order_awake(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
+                 std::span<const std::uint8_t> candidate,
+                 std::span<const std::uint32_t> awake_ids, SweepScratch& scratch) {
   const std::size_t n = boxes.size();
   scratch.start.resize(n);
   std::size_t awake_count = 0;
@@ -241,7 +233,6 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
     scratch.awake_width = std::max(scratch.awake_width, interval_width(boxes[i]));
     ++awake_count;
   }
-  // The awake list keeps last step's order for the bodies still awake, then appends the rest.
   std::vector<std::uint32_t>& awake = scratch.awake;
   std::erase_if(awake, [&](std::uint32_t i) { return i >= n || !candidate[i] || !active[i]; });
   const std::size_t kept = awake.size();
@@ -252,35 +243,45 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
       if (candidate[i] && !scratch.listed[i]) awake.push_back(i);
   }
   if (awake.size() - kept > awake.size() / 8) {
-    // Many newcomers (the first step, a mass wake-up): a full sort, not insertion.
     std::sort(awake.begin(), awake.end(), [&](std::uint32_t a, std::uint32_t b) {
       return scratch.start[a] < scratch.start[b] || (scratch.start[a] == scratch.start[b] && a < b);
     });
   } else {
     sort_by_start(awake, scratch.start);
   }
-  if (sleeping_key != scratch.sleeping_signature) {
-    scratch.sleeping.clear();
-    scratch.sleeping_width = 0.0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!candidate[i] || active[i]) continue;
-      scratch.start[i] = interval_start(boxes[i]);
-      scratch.sleeping.push_back(static_cast<std::uint32_t>(i));
-      scratch.sleeping_width =
-          std::max(scratch.sleeping_width, interval_end(boxes[i]) - scratch.start[i]);
-    }
-    std::sort(scratch.sleeping.begin(), scratch.sleeping.end(),
-              [&](std::uint32_t a, std::uint32_t b) {
-                return scratch.start[a] < scratch.start[b] ||
-                       (scratch.start[a] == scratch.start[b] && a < b);
-              });
-    scratch.sleeping_signature = sleeping_key;
+}
+
+/// The sleeping candidates in sweep order (scratch.sleeping, sleeping_width), sorted again
+/// only when their set has changed (sleeping_key).
+void order_sleeping(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
+                    std::span<const std::uint8_t> candidate, std::uint64_t sleeping_key,
+                    SweepScratch& scratch) {
+  if (sleeping_key == scratch.sleeping_signature) return;
+  scratch.sleeping.clear();
+  scratch.sleeping_width = 0.0;
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    if (!candidate[i] || active[i]) continue;
+    scratch.start[i] = interval_start(boxes[i]);
+    scratch.sleeping.push_back(static_cast<std::uint32_t>(i));
+    scratch.sleeping_width =
+        std::max(scratch.sleeping_width, interval_end(boxes[i]) - scratch.start[i]);
   }
-  build_slabs(scratch, boxes);
-  // The awake pairs slab by slab, then the pairs with sleeping bodies in sweep order: shared
-  // among the pool's threads in fixed ranges of each, each range with its own list; joined in
-  // range order they are the pairs of the two loops in order, whatever the thread count. One
-  // thread sweeps straight into `pairs`: no ranges to join.
+  std::sort(scratch.sleeping.begin(), scratch.sleeping.end(),
+            [&](std::uint32_t a, std::uint32_t b) {
+              return scratch.start[a] < scratch.start[b] ||
+                     (scratch.start[a] == scratch.start[b] && a < b);
+            });
+  scratch.sleeping_signature = sleeping_key;
+}
+
+/// The awake pairs slab by slab, then the pairs with sleeping bodies in sweep order, into
+/// `pairs`: shared among the pool's threads in fixed ranges of each, each range with its own
+/// list; joined in range order they are the pairs of the two loops in order, whatever the
+/// thread count. One thread sweeps straight into `pairs`: no ranges to join. Counts the
+/// sweep's cost (scratch.tests, swept).
+void sweep_pairs(std::span<const Aabb> boxes, SweepScratch& scratch,
+                 std::vector<BodyPair>& pairs, std::size_t max_pairs, WorkerPool& pool) {
+  const std::vector<std::uint32_t>& awake = scratch.awake;
   const std::size_t items = scratch.slab_items.size();
   const std::size_t ranges =
       pool.size() == 1 ? 1 : std::min<std::size_t>(4 * pool.size(), awake.size() / 64 + 1);
@@ -308,9 +309,30 @@ bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> activ
   if (ranges > 1)
     for (const std::vector<BodyPair>& part : scratch.range_pairs)
       pairs.insert(pairs.end(), part.begin(), part.end());
+}
+
+}  // namespace
+
+// Sweep and prune (Baraff 1992, "Dynamic simulation of non-penetrating rigid bodies", §7.4;
+// Ericson, Real-Time Collision Detection, §7.5.1): sort the boxes by where their projection
+// on the sweep direction starts and sweep, testing each box only against those whose
+// interval is still open. Bodies move little between steps, so last step's order is almost
+// sorted and insertion sort is about linear. Sleeping bodies do not move: they are sorted
+// once per change of the sleeping set, and each awake box finds the sleeping ones it may
+// touch by binary search over that list.
+bool find_pairs(std::span<const Aabb> boxes, std::span<const std::uint8_t> active,
+                std::span<const std::uint8_t> candidate,
+                std::span<const std::uint32_t> awake_ids, std::uint64_t sleeping_key,
+                SweepScratch& scratch, std::vector<BodyPair>& pairs, std::size_t max_pairs,
+                WorkerPool& pool) {
+  pairs.clear();
+  order_awake(boxes, active, candidate, awake_ids, scratch);
+  order_sleeping(boxes, active, candidate, sleeping_key, scratch);
+  build_slabs(scratch, boxes);
+  sweep_pairs(boxes, scratch, pairs, max_pairs, pool);
   const bool complete = pairs.size() <= max_pairs;  // a range stops only past max_pairs
   if (pairs.size() > max_pairs) pairs.resize(max_pairs);
-  sort_pairs(pairs, n, scratch);
+  sort_pairs(pairs, boxes.size(), scratch);
   return complete;
 }
 
