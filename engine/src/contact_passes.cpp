@@ -146,6 +146,51 @@ bool deeper_than(const Contact& c, double slop) {
   return false;
 }
 
+/// On several threads, the colours the sweeps share the contacts by (scratch.colours; none on
+/// one thread, or when the colours are too small to share: the sweeps then go in contact
+/// order). Each contact's two solver bodies are read on the pool: a contact is ~1 KB, and on
+/// the owner's thread alone this read missed the cache once per contact.
+void colour_for_threads(std::span<const Contact> contacts, std::size_t body_count,
+                        SolverScratch& scratch, WorkerPool& pool) {
+  ContactColours& colours = scratch.colours;
+  colours.offset.clear();
+  if (pool.size() == 1) return;
+  scratch.colour_a.resize(contacts.size());
+  scratch.colour_b.resize(contacts.size());
+  pool.for_each(contacts.size(), 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      scratch.colour_a[i] = contacts[i].a == kStaticBody ? -1 : scratch.index[contacts[i].a];
+      scratch.colour_b[i] = scratch.index[contacts[i].b];
+    }
+  });
+  colour_contacts(scratch.colour_a, scratch.colour_b, body_count, colours);
+  if (contacts.size() < kShared * colours.count()) colours.offset.clear();
+}
+
+/// Every contact's rows (Solver::prepare), slot k holding the contact the sweeps meet k-th:
+/// colour by colour, else contact order. Returns whether any point is deeper than the slop,
+/// found while each contact is in cache (the separations are the step start's and the solve
+/// does not change them).
+bool prepare_rows(Solver& solver, std::span<Contact> contacts, double dt,
+                  const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool) {
+  const ContactColours& colours = scratch.colours;
+  const bool coloured = colours.count() > 0;
+  if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
+  if (scratch.point_rows.size() < contacts.size()) scratch.point_rows.resize(contacts.size());
+  if (scratch.impulses.size() < contacts.size()) scratch.impulses.resize(contacts.size());
+  std::atomic<bool> deep{false};
+  pool.for_each(contacts.size(), 32, [&](std::size_t begin, std::size_t end) {
+    bool any = false;
+    for (std::size_t slot = begin; slot < end; ++slot) {
+      Contact& c = contacts[coloured ? colours.order[slot] : slot];
+      solver.prepare(c, slot, dt, settings);
+      any = any || deeper_than(c, settings.slop);
+    }
+    if (any) deep.store(true, std::memory_order_relaxed);
+  });
+  return deep.load(std::memory_order_relaxed);
+}
+
 }  // namespace
 
 // The velocities of the bodies in contact, in the order of Guendelman, Bridson & Fedkiw 2003:
@@ -160,41 +205,12 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
                    PassClock& clock) {
   constexpr std::size_t kBodyGrain = 128;
   Solver solver(bodies, solver_bodies, scratch, pool, dt * gravity);
-  ContactColours& colours = scratch.colours;
-  colours.offset.clear();  // one thread: no colours, the sweeps go in contact order
-  if (pool.size() > 1) {
-    // Each contact's two solver bodies, read on the pool: a contact is ~1 KB, and on the
-    // owner's thread alone this read missed the cache once per contact.
-    scratch.colour_a.resize(contacts.size());
-    scratch.colour_b.resize(contacts.size());
-    pool.for_each(contacts.size(), 256, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        scratch.colour_a[i] = contacts[i].a == kStaticBody ? -1 : scratch.index[contacts[i].a];
-        scratch.colour_b[i] = scratch.index[contacts[i].b];
-      }
-    });
-    colour_contacts(scratch.colour_a, scratch.colour_b, solver_bodies.size(), colours);
-    if (contacts.size() < kShared * colours.count()) colours.offset.clear();
-  }
+  colour_for_threads(contacts, solver_bodies.size(), scratch, pool);
   clock.lap(SolvePass::setup);
-  // Rows slot k holds the contact the sweeps meet k-th: colour by colour, else contact order.
+  const ContactColours& colours = scratch.colours;
   const bool coloured = colours.count() > 0;
   auto contact_at = [&](std::size_t slot) { return coloured ? colours.order[slot] : slot; };
-  if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
-  if (scratch.point_rows.size() < contacts.size()) scratch.point_rows.resize(contacts.size());
-  if (scratch.impulses.size() < contacts.size()) scratch.impulses.resize(contacts.size());
-  // Whether any point is deeper than the slop is found while each contact is in cache; the
-  // separations are the step start's and the solve does not change them.
-  std::atomic<bool> deep{false};
-  pool.for_each(contacts.size(), 32, [&](std::size_t begin, std::size_t end) {
-    bool any = false;
-    for (std::size_t slot = begin; slot < end; ++slot) {
-      Contact& c = contacts[contact_at(slot)];
-      solver.prepare(c, slot, dt, settings);
-      any = any || deeper_than(c, settings.slop);
-    }
-    if (any) deep.store(true, std::memory_order_relaxed);
-  });
+  const bool deep = prepare_rows(solver, contacts, dt, settings, scratch, pool);
   clock.lap(SolvePass::rows);
   std::atomic<int> impacts{0};
   sweep(scratch, contacts, pool, [&](Contact& c, std::size_t slot) {
@@ -214,7 +230,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   // The split impulse starts from zero pseudo velocities and only pushes: while no point is
   // deeper than the slop every target is ≤ 0 and every sweep would leave all of them zero (a
   // resting stack: `pyramid` spent 6 % of its instructions proving that).
-  const bool split = deep.load(std::memory_order_relaxed) && settings.position_iterations > 0;
+  const bool split = deep && settings.position_iterations > 0;
   auto split_impulse = [&](Contact&, std::size_t slot) { solver.solve_position(slot); };
   if (settings.shock_propagation && split && pool.size() == 2 && coloured) {
     shock_beside_split(solver, scratch, contacts, gravity, dt, settings, pool, split_impulse);
