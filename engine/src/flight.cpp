@@ -67,7 +67,7 @@ struct LoneStep {
     // without the call for the 80-90 % of a fall's body-steps that touch nothing).
     if (b.in_contact) slept += settle_lone_body(b, id, ctx.cache, ctx.dt, ctx.world) ? 1 : 0;
     else b.still_time = 0.0;
-    note_moved(ctx.broad, id, b.s);
+    note_flown(ctx, id, b);
   }
 };
 

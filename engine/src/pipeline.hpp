@@ -94,6 +94,9 @@ struct BroadPhaseCache {
   std::vector<std::uint8_t> inside;
   std::vector<std::uint8_t> stale;       ///< boxes[i] not recomputed this step (quiet body).
   std::vector<std::uint8_t> paired;      ///< Body is in fat_pairs.
+  /// Body had no fat pair after the last sweep: its next fat box may reach down to the floor
+  /// and up to where its energy can lift it (fat_box).
+  std::vector<std::uint8_t> alone;
   std::vector<std::uint32_t> refit;      ///< Bodies whose fat box changed since the last sweep.
   std::vector<std::uint8_t> in_refit;    ///< Body is in `refit`.
   std::vector<std::uint32_t> near;       ///< Scratch: the bodies one query found.
@@ -204,6 +207,19 @@ bool settle_lone_body(Body& b, std::uint32_t id, ContactCache& cache, double dt,
 /// for distinct bodies.
 inline void note_moved(BroadPhaseCache& k, std::uint32_t i, const BodyState& s) {
   if (i < k.inside.size()) k.inside[i] = within(k.quiet[i], s);
+}
+
+/// A new quiet bound for body i, in flight and out of its last one, from its fat box, where it
+/// has no cached pair (broad_phase.cpp). Thread-safe for distinct i.
+void renew_quiet(StepContext& ctx, std::uint32_t i, const Body& b);
+
+/// note_moved for lone body i after its flight: a body in flight that outlived its quiet
+/// bound takes a new one (renew_quiet). Thread-safe for distinct i.
+inline void note_flown(StepContext& ctx, std::uint32_t i, const Body& b) {
+  BroadPhaseCache& k = ctx.broad;
+  if (i >= k.inside.size()) return;
+  k.inside[i] = within(k.quiet[i], b.s);
+  if (!k.inside[i] && !b.in_contact && k.quiet[i].p2 >= 0.0) renew_quiet(ctx, i, b);
 }
 
 /// Pairs of bodies whose boxes overlap as placed (stops counting just past pair_budget).
