@@ -81,8 +81,9 @@ std::pair<double, double> parabola_range(double v, double g, double T) {
 /// centre stays between the floor and the height its energy lifts it to; its box reaches
 /// further by its largest half extent (the bounding radius) and by the swept box's reach at
 /// the most speed that energy allows. Gravity must point straight down, −y.
-std::pair<double, double> floor_to_apex(const Body& b, const Floor& floor, double g, double dt) {
-  const Vec3 v = velocity(b.s, b.c);
+/// v: the body's velocity, m/s.
+std::pair<double, double> floor_to_apex(const Body& b, const Vec3& v, const Floor& floor,
+                                        double g, double dt) {
   const Vec3 w = angular_velocity(b.s, b.c);
   const double kinetic = 0.5 * (b.s.P.dot(v) + b.s.L.dot(w)) * b.c.inv_mass;  // J/kg
   const double energy = kinetic + g * std::max(b.s.x.y() - floor.height, 0.0);  // J/kg
@@ -118,7 +119,7 @@ Aabb fat_box(const Aabb& tight, const Body& b, const WorldDef& world, double dt,
     fat.hi[i] = tight.hi[i] + hi + margin;
   }
   if (alone && world.floor && gravity.x() == 0.0 && gravity.z() == 0.0 && gravity.y() < 0.0) {
-    const auto [lo, hi] = floor_to_apex(b, *world.floor, -gravity.y(), dt);
+    const auto [lo, hi] = floor_to_apex(b, v, *world.floor, -gravity.y(), dt);
     fat.lo.y() = std::min(fat.lo.y(), lo - margin);
     fat.hi.y() = std::max(fat.hi.y(), hi + margin);
   }

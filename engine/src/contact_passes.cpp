@@ -167,14 +167,18 @@ void colour_for_threads(std::span<const Contact> contacts, std::size_t body_coun
   if (contacts.size() < kShared * colours.count()) colours.offset.clear();
 }
 
+/// The contact the sweeps meet `slot`-th: colour by colour when there are colours, else in
+/// contact order.
+std::size_t contact_in_slot(const ContactColours& colours, std::size_t slot) {
+  return colours.count() > 0 ? colours.order[slot] : slot;
+}
+
 /// Every contact's rows (Solver::prepare), slot k holding the contact the sweeps meet k-th:
 /// colour by colour, else contact order. Returns whether any point is deeper than the slop,
 /// found while each contact is in cache (the separations are the step start's and the solve
 /// does not change them).
 bool prepare_rows(Solver& solver, std::span<Contact> contacts, double dt,
                   const SolverSettings& settings, SolverScratch& scratch, WorkerPool& pool) {
-  const ContactColours& colours = scratch.colours;
-  const bool coloured = colours.count() > 0;
   if (scratch.rows.size() < contacts.size()) scratch.rows.resize(contacts.size());
   if (scratch.point_rows.size() < contacts.size()) scratch.point_rows.resize(contacts.size());
   if (scratch.impulses.size() < contacts.size()) scratch.impulses.resize(contacts.size());
@@ -182,7 +186,7 @@ bool prepare_rows(Solver& solver, std::span<Contact> contacts, double dt,
   pool.for_each(contacts.size(), 32, [&](std::size_t begin, std::size_t end) {
     bool any = false;
     for (std::size_t slot = begin; slot < end; ++slot) {
-      Contact& c = contacts[coloured ? colours.order[slot] : slot];
+      Contact& c = contacts[contact_in_slot(scratch.colours, slot)];
       solver.prepare(c, slot, dt, settings);
       any = any || deeper_than(c, settings.slop);
     }
@@ -209,7 +213,6 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   clock.lap(SolvePass::setup);
   const ContactColours& colours = scratch.colours;
   const bool coloured = colours.count() > 0;
-  auto contact_at = [&](std::size_t slot) { return coloured ? colours.order[slot] : slot; };
   const bool deep = prepare_rows(solver, contacts, dt, settings, scratch, pool);
   clock.lap(SolvePass::rows);
   std::atomic<int> impacts{0};
@@ -224,7 +227,7 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   // Shock propagation and the next step's warm start read the impulses in the contacts.
   pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
     for (std::size_t slot = begin; slot < end; ++slot)
-      solver.store_impulses(contacts[contact_at(slot)], slot);
+      solver.store_impulses(contacts[contact_in_slot(colours, slot)], slot);
   });
   clock.lap(SolvePass::velocity);
   // The split impulse starts from zero pseudo velocities and only pushes: while no point is

@@ -158,11 +158,17 @@ std::size_t near_in(const std::vector<std::uint32_t>& order, const std::vector<d
   return tests;
 }
 
-/// Keeps `list` = the bodies with flag set, sorted by start (insertion sort from last order).
-void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& start) {
-  auto less = [&](std::uint32_t a, std::uint32_t b) {
+/// The sweep order of bodies: by interval start, then by index (a strict total order, so every
+/// sort gives the same list).
+auto by_start(const std::vector<double>& start) {
+  return [&start](std::uint32_t a, std::uint32_t b) {
     return start[a] < start[b] || (start[a] == start[b] && a < b);
   };
+}
+
+/// Keeps `list` = the bodies with flag set, sorted by start (insertion sort from last order).
+void sort_by_start(std::vector<std::uint32_t>& list, const std::vector<double>& start) {
+  const auto less = by_start(start);
   for (std::size_t i = 1; i < list.size(); ++i) {
     const std::uint32_t key = list[i];
     std::size_t j = i;
@@ -243,9 +249,7 @@ void order_awake(std::span<const Aabb> boxes, std::span<const std::uint8_t> acti
       if (candidate[i] && !scratch.listed[i]) awake.push_back(i);
   }
   if (awake.size() - kept > awake.size() / 8) {
-    std::sort(awake.begin(), awake.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return scratch.start[a] < scratch.start[b] || (scratch.start[a] == scratch.start[b] && a < b);
-    });
+    std::sort(awake.begin(), awake.end(), by_start(scratch.start));
   } else {
     sort_by_start(awake, scratch.start);
   }
@@ -266,11 +270,7 @@ void order_sleeping(std::span<const Aabb> boxes, std::span<const std::uint8_t> a
     scratch.sleeping_width =
         std::max(scratch.sleeping_width, interval_end(boxes[i]) - scratch.start[i]);
   }
-  std::sort(scratch.sleeping.begin(), scratch.sleeping.end(),
-            [&](std::uint32_t a, std::uint32_t b) {
-              return scratch.start[a] < scratch.start[b] ||
-                     (scratch.start[a] == scratch.start[b] && a < b);
-            });
+  std::sort(scratch.sleeping.begin(), scratch.sleeping.end(), by_start(scratch.start));
   scratch.sleeping_signature = sleeping_key;
 }
 
