@@ -64,14 +64,21 @@ void sweep_in_order(std::span<Contact> contacts, Fn&& fn, int passes, bool first
 /// converged more slowly (docs/engine-log.md, "Sweeps both ways"). With it ten sweeps hold the
 /// 5,050-box pyramid better than twelve forward did (top box 1.05 mm against 1.93 mm); nine
 /// let it fall.
+///
+/// `beside` (if any) runs once, as a phase of one chunk before the first colour: the thread
+/// that takes it joins the sweeps where the others have got to (as shock propagation's
+/// BesideJob). It must read and write nothing the sweeps do.
 template <typename Fn>
 void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool, Fn&& fn,
-           int passes = 1, bool first_backward = false) {
+           int passes = 1, bool first_backward = false, BesideJob beside = {}) {
   constexpr std::size_t kGrain = 8;  // contacts per chunk: 0.1–0.5 µs each
   auto backward = [&](int pass) { return runs_backward(first_backward, passes, pass); };
   ContactColours& colours = scratch.colours;
-  if (pool.size() == 1 || colours.count() == 0)
+  if (pool.size() == 1 || colours.count() == 0) {
+    if (beside.run) beside.run(beside.arg);
     return sweep_in_order(contacts, fn, passes, first_backward);
+  }
+  const std::size_t first = beside.run ? 1 : 0;  // phases before the first colour's
   const std::size_t count = colours.count();
   const std::span<SolverBody> sb(scratch.bodies);
   // The turns go on counting from the solve's earlier passes (turn_base): zeroing them here,
@@ -79,12 +86,16 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
   // of `pile`'s step on two threads, in five passes, while the other thread waited).
   const std::span<const std::uint32_t> base(scratch.turn_base);
   pool.for_each_phase(
-      count * static_cast<std::size_t>(passes), kGrain,
-      [&](std::size_t phase) {
+      first + count * static_cast<std::size_t>(passes), kGrain,
+      [&](std::size_t p) {
+        if (p < first) return std::size_t{1};
+        const std::size_t phase = p - first;
         const bool back = backward(static_cast<int>(phase / count));
         return colours.of(back ? count - 1 - phase % count : phase % count).size();
       },
-      [&](std::size_t phase, std::size_t begin, std::size_t end) {
+      [&](std::size_t p, std::size_t begin, std::size_t end) {
+        if (p < first) return beside.run(beside.arg);
+        const std::size_t phase = p - first;
         const auto pass = static_cast<std::uint32_t>(phase / count);
         const bool back = backward(static_cast<int>(pass));
         const std::size_t colour = back ? count - 1 - phase % count : phase % count;
@@ -222,8 +233,14 @@ int solve_contacts(std::span<Body> bodies, std::span<const std::uint32_t> solver
   clock.lap(SolvePass::impacts);
   sweep(scratch, contacts, pool, [&](Contact&, std::size_t slot) { solver.warm_start(slot); });
   clock.lap(SolvePass::warm_start);
+  // On several threads shock propagation's order is found beside the sweeps (one thread takes
+  // it, then joins them): it was a serial stretch of its own.
+  auto plan = [&] { solver.plan_shock_propagation(contacts, gravity); };
+  using Plan = decltype(plan);
+  const BesideJob plan_beside{[](void* job) { (*static_cast<Plan*>(job))(); }, &plan};
   sweep(scratch, contacts, pool, [&](Contact&, std::size_t slot) { solver.solve_velocity(slot); },
-        settings.velocity_iterations, settings.first_sweep_backward);
+        settings.velocity_iterations, settings.first_sweep_backward,
+        settings.shock_propagation && coloured ? plan_beside : BesideJob{});
   // Shock propagation and the next step's warm start read the impulses in the contacts.
   pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
     for (std::size_t slot = begin; slot < end; ++slot)

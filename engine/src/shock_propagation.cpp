@@ -38,39 +38,63 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
   const double g = gravity.norm();
   if (g == 0.0) return alone();
   const Vec3 up = -gravity / g;
-  find_supports(contacts, up, pool);
-  const std::size_t groups = order_supports_by_height();
+  if (!shock_plan_.ready) {
+    supports_.resize(contacts.size());
+    pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
+      find_supports(contacts, up, begin, end);
+    });
+    order_shock_propagation(pool.size() > 1);
+  }
+  const std::size_t groups = shock_plan_.groups;
   if (pool.size() == 1 || groups == 0) {  // the height order itself: what the waves replay
     for (std::size_t gi = 0; gi < groups; ++gi) push_up_body(contacts, group(gi), up, dt);
     return alone();
   }
-  const std::uint32_t last = number_waves(groups);
-  order_groups_by_wave(groups, last);
-  push_up_in_waves(contacts, up, dt, pool, beside, last);
+  push_up_in_waves(contacts, up, dt, pool, beside, last_wave_);
+}
+
+// Nothing in the order reads a velocity: it is the supports' geometry at the step start. On
+// several threads it is found beside the velocity sweeps (solve_contacts), where it was a
+// serial stretch of ~60 µs of `pile`'s step (the entries written on the other core, read back
+// one line at a time), during which the other thread waited.
+void Solver::plan_shock_propagation(std::span<const Contact> contacts, const Vec3& gravity) {
+  const double g = gravity.norm();
+  if (g == 0.0) return;
+  supports_.resize(contacts.size());
+  find_supports(contacts, -gravity / g, 0, contacts.size());
+  order_shock_propagation(true);
+}
+
+void Solver::order_shock_propagation(bool waves) {
+  shock_plan_.groups = order_supports_by_height();
+  if (waves && shock_plan_.groups > 0) {
+    last_wave_ = number_waves(shock_plan_.groups);
+    order_groups_by_wave(shock_plan_.groups, last_wave_);
+  }
+  shock_plan_.ready = true;
 }
 
 // A contact whose normal is nearly horizontal supports nothing and is left to the iterations,
 // as is one that would hold the floor up (gravity pointing away from it): the floor does not
 // move, and the body under it has no support to be pushed from. Each contact's entry (with its
-// lower body's solver index, for the waves) is found on the pool: on the owner's thread alone
-// this read every ~1 KB contact, a cache miss each, while the other threads waited. With the
-// bucket sort of order_supports_by_height, the pass's serial part in `pile` on two threads
-// went from ~124 to ~81 µs a step (the same bits).
-void Solver::find_supports(std::span<const Contact> contacts, const Vec3& up, WorkerPool& pool) {
+// lower body's solver index, for the waves) is found on the pool, or on one thread beside the
+// velocity sweeps: on the owner's thread alone, while the other threads waited, this read
+// every ~1 KB contact, a cache miss each. With the bucket sort of order_supports_by_height,
+// the pass's serial part in `pile` on two threads went from ~124 to ~81 µs a step (the same
+// bits).
+void Solver::find_supports(std::span<const Contact> contacts, const Vec3& up, std::size_t begin,
+                           std::size_t end) {
   constexpr double kSupportCosine = 0.3;  // |n·up| below this: a side contact (> 72° from up)
   std::vector<SupportEntry>& found = supports_;
-  found.resize(contacts.size());
-  pool.for_each(contacts.size(), 64, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const Contact& c = contacts[i];
-      const std::uint32_t upper = upper_of(c, up);
-      found[i].upper = kStaticBody;
-      if (std::abs(c.normal.dot(up)) < kSupportCosine || upper == kStaticBody) continue;
-      const std::uint32_t lower = c.a == upper ? c.b : c.a;
-      found[i] = {up.dot(bodies_[upper].s.x), upper, static_cast<std::uint32_t>(i),
-                  lower == kStaticBody ? -1 : index_[lower], 0};
-    }
-  });
+  for (std::size_t i = begin; i < end; ++i) {
+    const Contact& c = contacts[i];
+    const std::uint32_t upper = upper_of(c, up);
+    found[i].upper = kStaticBody;
+    if (std::abs(c.normal.dot(up)) < kSupportCosine || upper == kStaticBody) continue;
+    const std::uint32_t lower = c.a == upper ? c.b : c.a;
+    found[i] = {up.dot(bodies_[upper].s.x), upper, static_cast<std::uint32_t>(i),
+                lower == kStaticBody ? -1 : index_[lower], 0};
+  }
 }
 
 // By the height of the supported body (then its id), its contacts together in contact order,

@@ -92,9 +92,16 @@ class Solver {
   /// pass where the others have got to.
   void shock_propagation(std::span<Contact> contacts, const Vec3& gravity, double dt,
                          WorkerPool& pool, BesideJob beside = {});
-  /// Shock propagation's entry of each contact into supports_ (upper kStaticBody: not a
-  /// support), on the pool.
-  void find_supports(std::span<const Contact> contacts, const Vec3& up, WorkerPool& pool);
+  /// Shock propagation's order (its supports by height and, with several threads, its
+  /// waves), found on this thread alone; shock_propagation then uses it. Reads no velocity,
+  /// so it may run beside the velocity sweeps.
+  void plan_shock_propagation(std::span<const Contact> contacts, const Vec3& gravity);
+  /// Shock propagation's entry of contacts [begin, end) into supports_ (sized to the
+  /// contacts; upper kStaticBody: not a support). Thread-safe across ranges.
+  void find_supports(std::span<const Contact> contacts, const Vec3& up, std::size_t begin,
+                     std::size_t end);
+  /// From the supports found: their order by height and, with `waves`, the waves.
+  void order_shock_propagation(bool waves);
   /// Groups the supports by the body they hold up, bodies by height (order_, group_start_);
   /// returns the number of groups.
   std::size_t order_supports_by_height();
@@ -188,6 +195,11 @@ class Solver {
   std::vector<std::uint32_t>& turn_base_;   // turns each body took earlier in the solve
   std::vector<std::uint32_t>& upper_turn_;  // each solve's turn at its upper body
   std::vector<std::uint32_t>& group_start_;  // start of each body's supports in order_
+  struct ShockPlan {
+    bool ready = false;      // the order below is found
+    std::size_t groups = 0;  // bodies held up (groups of order_)
+  } shock_plan_;
+  std::uint32_t last_wave_ = 0;  // shock propagation's last wave (several threads)
 };
 
 }  // namespace tumble
