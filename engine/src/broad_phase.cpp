@@ -268,18 +268,10 @@ bool rescan(StepContext& ctx) {
   return pairs_hold;
 }
 
-/// Makes `pairs` sorted and unique again after pairs were appended past its first `cached`
-/// (sorted, unique): the new ones not yet listed are sorted and moved into place from the
-/// back, block by block, each found by binary search. A merge and a unique pass over the whole
-/// list cost ~50 instructions per cached pair, 2 % of `pile`, all of it on one thread; the few
-/// new pairs (a woken body's neighbours) now cost a search each and a memmove.
-void insert_sorted(std::vector<BodyPair>& pairs, std::size_t cached, std::vector<BodyPair>& fresh) {
-  const auto old_end = pairs.begin() + static_cast<std::ptrdiff_t>(cached);
-  fresh.clear();
-  std::sort(old_end, pairs.end());
-  for (auto it = old_end; it != pairs.end(); ++it)
-    if ((fresh.empty() || fresh.back() != *it) && !std::binary_search(pairs.begin(), old_end, *it))
-      fresh.push_back(*it);
+/// Moves the sorted pairs `fresh`, none of them in the sorted list `pairs`, into their places
+/// in it: from the back, block by block, each place found by binary search.
+void merge_fresh(std::vector<BodyPair>& pairs, std::span<const BodyPair> fresh) {
+  const std::size_t cached = pairs.size();
   pairs.resize(cached + fresh.size());
   auto end = pairs.begin() + static_cast<std::ptrdiff_t>(cached);  // old pairs not yet moved
   for (std::size_t j = fresh.size(); j-- > 0;) {
@@ -289,6 +281,26 @@ void insert_sorted(std::vector<BodyPair>& pairs, std::size_t cached, std::vector
     *(at + static_cast<std::ptrdiff_t>(j)) = fresh[j];
     end = at;
   }
+}
+
+/// Makes `added` sorted and unique again after pairs were appended past its first `cached`
+/// (sorted, unique), dropping those the sweep's `swept` already holds: the new ones are sorted
+/// and moved into place (merge_fresh). A merge and a unique pass over one list of every pair
+/// cost ~50 instructions per cached pair, 2 % of `pile`, all of it on one thread; moving the
+/// few new pairs into that list still moved all of it behind them, ~20 µs each time a body
+/// left its fat box (most steps of a falling pile). The added pairs are few until the next
+/// sweep: filter_pairs merges them into each step's pairs.
+void add_sorted(std::vector<BodyPair>& added, std::size_t cached,
+                const std::vector<BodyPair>& swept, std::vector<BodyPair>& fresh) {
+  const auto old_end = added.begin() + static_cast<std::ptrdiff_t>(cached);
+  fresh.clear();
+  std::sort(old_end, added.end());
+  for (auto it = old_end; it != added.end(); ++it)
+    if ((fresh.empty() || fresh.back() != *it) && !std::binary_search(added.begin(), old_end, *it) &&
+        !std::binary_search(swept.begin(), swept.end(), *it))
+      fresh.push_back(*it);
+  added.resize(cached);
+  merge_fresh(added, fresh);
 }
 
 /// The overlap tests that pairing `count` bodies one by one is expected to cost: per body,
@@ -313,13 +325,13 @@ bool add_woken_pairs(StepContext& ctx) {
   BroadPhaseCache& k = ctx.broad;
   const std::size_t n = ctx.bodies.size();
   if (pairing_cost(k, k.woken.size()) > std::max(kMaxTests, k.sweep.tests)) return false;
-  if (k.fat_pairs.size() > 2 * k.swept_pairs + 64) return false;
+  if (k.fat_pairs.size() + k.added_pairs.size() > 2 * k.swept_pairs + 64) return false;
   for (std::uint32_t w : k.woken) {
     k.fat[w] = fat_box(k.boxes[w], ctx.bodies[w], ctx.world, ctx.dt, k.alone[w]);
     end_quiet(ctx, w);
     if (!k.in_refit[w]) k.in_refit[w] = 1, k.refit.push_back(w);
   }
-  const std::size_t cached = k.fat_pairs.size();
+  const std::size_t cached = k.added_pairs.size();
   for (std::uint32_t w : k.woken) {
     k.near.clear();
     boxes_near(k.sweep, k.fat, k.fat[w], k.near);
@@ -327,14 +339,15 @@ bool add_woken_pairs(StepContext& ctx) {
       if (overlaps(k.fat[w], k.fat[x])) k.near.push_back(x);
     for (std::uint32_t x : k.near) {
       if (x == w || !k.candidate[x]) continue;
-      k.fat_pairs.emplace_back(std::min(w, x), std::max(w, x));
+      k.added_pairs.emplace_back(std::min(w, x), std::max(w, x));
       k.paired[w] = k.paired[x] = 1;
       k.alone[w] = k.alone[x] = 0;
       end_quiet(ctx, x);
     }
   }
-  if (k.fat_pairs.size() > pair_budget(n)) return false;  // a sweep says which to keep
-  insert_sorted(k.fat_pairs, cached, k.sweep.sorted);
+  // A sweep says which to keep.
+  if (k.fat_pairs.size() + k.added_pairs.size() > pair_budget(n)) return false;
+  add_sorted(k.added_pairs, cached, k.fat_pairs, k.sweep.sorted);
   // A woken body that met nobody gets its quiet bound back, as after a sweep.
   for (std::uint32_t w : k.woken)
     if (!k.paired[w])
@@ -365,39 +378,47 @@ bool pair_escaped(BroadPhaseCache& k, std::size_t escaped, std::size_t n) {
 /// order. In `pile` that is thousands of pairs a step, a fifth of the broad phase: shared
 /// among the pool's threads in fixed ranges of the pairs, each kept in a list of its own (the
 /// sweep's, free once its pairs are joined) and joined in range order, so the same list on
-/// any thread count.
+/// any thread count. The added pairs' are merged in after (merge_fresh).
 void filter_pairs(StepContext& ctx) {
   constexpr std::size_t kGrain = 2048;  // pairs per range: ~10 ns each
   BroadPhaseCache& k = ctx.broad;
-  // Local views: through `k` every push_back would reload the lists it might have changed.
-  const std::span<const BodyPair> pairs(k.fat_pairs);
   const std::uint8_t* active = k.active.data();
   const Aabb* boxes = k.boxes.data();
   // Every pair is written and the count moves on only for those kept: no branch on the test.
-  auto keep = [&](std::size_t begin, std::size_t end, std::vector<BodyPair>& out) {
+  auto keep = [&](std::span<const BodyPair> pairs, std::vector<BodyPair>& out) {
     std::size_t count = out.size();
-    out.resize(count + (end - begin));
+    out.resize(count + pairs.size());
     BodyPair* to = out.data();
-    for (const BodyPair& p : pairs.subspan(begin, end - begin)) {
+    for (const BodyPair& p : pairs) {
       to[count] = p;
       const bool awake = (active[p.first] | active[p.second]) != 0;
       count += int{awake} & int{overlaps(boxes[p.first], boxes[p.second])};
     }
     out.resize(count);
   };
+  // Local views: through `k` every push_back would reload the lists it might have changed.
+  const std::span<const BodyPair> pairs(k.fat_pairs);
   const std::size_t n = pairs.size();
   const std::size_t ranges = std::min<std::size_t>(4 * ctx.pool.size(), n / kGrain);
-  if (ranges < 2) return keep(0, n, ctx.scratch.pairs);
-  std::vector<std::vector<BodyPair>>& parts = k.sweep.range_pairs;
-  if (parts.size() < ranges) parts.resize(ranges);
-  ctx.pool.for_each(ranges, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t r = begin; r < end; ++r) {
-      parts[r].clear();
-      keep(n * r / ranges, n * (r + 1) / ranges, parts[r]);
-    }
-  });
-  for (std::size_t r = 0; r < ranges; ++r)
-    ctx.scratch.pairs.insert(ctx.scratch.pairs.end(), parts[r].begin(), parts[r].end());
+  if (ranges < 2) {
+    keep(pairs, ctx.scratch.pairs);
+  } else {
+    std::vector<std::vector<BodyPair>>& parts = k.sweep.range_pairs;
+    if (parts.size() < ranges) parts.resize(ranges);
+    ctx.pool.for_each(ranges, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t r = begin; r < end; ++r) {
+        parts[r].clear();
+        keep(pairs.subspan(n * r / ranges, n * (r + 1) / ranges - n * r / ranges), parts[r]);
+      }
+    });
+    for (std::size_t r = 0; r < ranges; ++r)
+      ctx.scratch.pairs.insert(ctx.scratch.pairs.end(), parts[r].begin(), parts[r].end());
+  }
+  if (k.added_pairs.empty()) return;
+  std::vector<BodyPair>& added = k.sweep.sorted;
+  added.clear();
+  keep(k.added_pairs, added);
+  merge_fresh(ctx.scratch.pairs, added);
 }
 
 /// Every awake body's fat box anew (the long box for those found alone, with `long_boxes`),
@@ -471,6 +492,7 @@ void broad_phase(StepContext& ctx) {
     if (!k.fat_complete && std::any_of(k.awake.begin(), k.awake.end(),
                                        [&](std::uint32_t i) { return k.alone[i] != 0; }))
       k.fat_complete = sweep_fat_boxes(ctx, false);
+    k.added_pairs.clear();
     k.swept_pairs = k.fat_pairs.size();
     k.fat_valid = true;
     k.in_refit.resize(n);

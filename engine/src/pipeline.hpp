@@ -79,9 +79,12 @@ struct BroadPhaseCache {
   std::vector<Aabb> boxes;               ///< Each body's swept box this step.
   std::vector<std::uint8_t> box_cached;  ///< boxes[i] is a sleeping body's, still valid.
   std::vector<Aabb> fat;                 ///< Boxes the cached pairs were found for.
-  std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes.
-  bool fat_valid = false;                ///< fat_pairs holds every pair that can touch,
-                                         ///< but those of the bodies in `woken`.
+  std::vector<BodyPair> fat_pairs;       ///< Pairs of overlapping fat boxes (the last sweep's).
+  /// Pairs found for bodies woken or escaped since the last sweep (add_woken_pairs), sorted,
+  /// none of them in fat_pairs; the two lists hold the pairs that can touch.
+  std::vector<BodyPair> added_pairs;
+  bool fat_valid = false;                ///< fat_pairs and added_pairs hold every pair that
+                                         ///< can touch, but those of the bodies in `woken`.
   std::vector<std::uint32_t> woken;      ///< Bodies woken, or out of their fat box, since
                                          ///< fat_pairs was found.
   std::vector<std::uint8_t> unpaired;    ///< Body is in `woken` (its fat box is stale).
@@ -93,7 +96,7 @@ struct BroadPhaseCache {
   /// changes (note_moved), so the next broad phase reads a byte, not the body.
   std::vector<std::uint8_t> inside;
   std::vector<std::uint8_t> stale;       ///< boxes[i] not recomputed this step (quiet body).
-  std::vector<std::uint8_t> paired;      ///< Body is in fat_pairs.
+  std::vector<std::uint8_t> paired;      ///< Body is in fat_pairs or added_pairs.
   /// Body had no fat pair after the last sweep: its next fat box may reach down to the floor
   /// and up to where its energy can lift it (fat_box).
   std::vector<std::uint8_t> alone;
