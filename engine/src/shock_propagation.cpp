@@ -50,7 +50,7 @@ void Solver::shock_propagation(std::span<Contact> contacts, const Vec3& gravity,
     for (std::size_t gi = 0; gi < groups; ++gi) push_up_body(contacts, group(gi), up, dt);
     return alone();
   }
-  push_up_in_waves(contacts, up, dt, pool, beside, last_wave_);
+  push_up_in_waves(contacts, up, dt, pool, beside, shock_plan_.last_wave);
 }
 
 // Nothing in the order reads a velocity: it is the supports' geometry at the step start. On
@@ -68,8 +68,8 @@ void Solver::plan_shock_propagation(std::span<const Contact> contacts, const Vec
 void Solver::order_shock_propagation(bool waves) {
   shock_plan_.groups = order_supports_by_height();
   if (waves && shock_plan_.groups > 0) {
-    last_wave_ = number_waves(shock_plan_.groups);
-    order_groups_by_wave(shock_plan_.groups, last_wave_);
+    shock_plan_.last_wave = number_waves(shock_plan_.groups);
+    order_groups_by_wave(shock_plan_.groups, shock_plan_.last_wave);
   }
   shock_plan_.ready = true;
 }

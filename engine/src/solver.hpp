@@ -196,10 +196,10 @@ class Solver {
   std::vector<std::uint32_t>& upper_turn_;  // each solve's turn at its upper body
   std::vector<std::uint32_t>& group_start_;  // start of each body's supports in order_
   struct ShockPlan {
-    bool ready = false;      // the order below is found
-    std::size_t groups = 0;  // bodies held up (groups of order_)
+    bool ready = false;          // shock propagation's order is found
+    std::size_t groups = 0;      // bodies held up (groups of order_)
+    std::uint32_t last_wave = 0; // its last wave (several threads)
   } shock_plan_;
-  std::uint32_t last_wave_ = 0;  // shock propagation's last wave (several threads)
 };
 
 }  // namespace tumble
