@@ -415,7 +415,7 @@ void filter_pairs(StepContext& ctx) {
       ctx.scratch.pairs.insert(ctx.scratch.pairs.end(), parts[r].begin(), parts[r].end());
   }
   if (k.added_pairs.empty()) return;
-  std::vector<BodyPair>& added = k.sweep.sorted;
+  std::vector<BodyPair>& added = k.sweep.sorted;  // the sweep's sort scratch, free here
   added.clear();
   keep(k.added_pairs, added);
   merge_fresh(ctx.scratch.pairs, added);
