@@ -107,8 +107,8 @@ void sweep(SolverScratch& scratch, std::span<Contact> contacts, WorkerPool& pool
         for (std::size_t slot = start + begin; slot < start + end; ++slot) {
           const std::uint32_t k = colours.order[slot];
           const std::int32_t a = scratch.colour_a[k], b = scratch.colour_b[k];
-          if (a >= 0) wait_turn(sb[a].turn, rank(a, colours.rank_a[k]));
-          if (b >= 0) wait_turn(sb[b].turn, rank(b, colours.rank_b[k]));
+          if (a >= 0) pool.wait_turn(sb[a].turn, rank(a, colours.rank_a[k]));
+          if (b >= 0) pool.wait_turn(sb[b].turn, rank(b, colours.rank_b[k]));
           fn(contacts[k], slot);
           if (a >= 0) pass_turn(sb[a].turn);
           if (b >= 0) pass_turn(sb[b].turn);

@@ -192,9 +192,9 @@ void Solver::push_up_in_waves(std::span<Contact> contacts, const Vec3& up, doubl
     const std::span<const SupportEntry> supports = group(gi);
     const std::int32_t u = index_[supports[0].upper];
     SolverBody& upper = sb_[u];
-    wait_turn(upper.turn, turn_base_[u] + upper_turn_[gi]);
+    pool.wait_turn(upper.turn, turn_base_[u] + upper_turn_[gi]);
     for (const SupportEntry& e : supports)
-      if (e.lower >= 0) wait_turn(sb_[e.lower].turn, turn_base_[e.lower] + e.lower_turn);
+      if (e.lower >= 0) pool.wait_turn(sb_[e.lower].turn, turn_base_[e.lower] + e.lower_turn);
     push_up_body(contacts, supports, up, dt);
     pass_turn(upper.turn);
     for (const SupportEntry& e : supports)

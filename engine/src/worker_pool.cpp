@@ -1,6 +1,7 @@
 #include "worker_pool.hpp"
 
 #include <algorithm>
+#include <ctime>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -21,6 +22,13 @@ namespace {
 constexpr int kSpinRounds = 1 << 10;
 constexpr int kBusySpinRounds = 1 << 13;
 
+/// CPU time of the calling thread, ns (one system call, ~0.2 µs).
+std::uint64_t thread_cpu_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000u + static_cast<std::uint64_t>(t.tv_nsec);
+}
+
 void cpu_relax() {
 #if defined(__x86_64__) || defined(__i386__)
   _mm_pause();
@@ -31,12 +39,61 @@ void cpu_relax() {
 
 }  // namespace
 
-void wait_turn(std::uint32_t& counter, std::uint32_t turn) {
-  const std::atomic_ref<std::uint32_t> c(counter);
-  for (int spins = 0; c.load(std::memory_order_acquire) != turn; ++spins) {
-    if (spins < kSpinRounds) cpu_relax();
-    else std::this_thread::yield();
+bool SoloPolicy::next_solo(std::uint64_t wall_ns, std::uint64_t stalled_ns) {
+  if (left_ > 0) {  // a step alone; after the last one, a shared step tries the cores again
+    if (--left_ == 0) since_ = 0;
+    return left_ > 0;
   }
+  if (4 * stalled_ns > wall_ns) {
+    length_ = since_ < kRecent ? std::min(2 * length_, kMost) : kFirst;
+    left_ = length_;
+    return true;
+  }
+  since_ = std::min(since_ + 1, kRecent);
+  return false;
+}
+
+// A wait past its spinning reads the clock once when it starts yielding and once when it
+// ends: waits that short are free of clock reads, and only the long ones count as held up.
+void WorkerPool::wait_turn(std::uint32_t& counter, std::uint32_t turn) {
+  const std::atomic_ref<std::uint32_t> c(counter);
+  int spins = 0;
+  for (; spins < kSpinRounds; ++spins) {
+    if (c.load(std::memory_order_acquire) == turn) return;
+    cpu_relax();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  while (c.load(std::memory_order_acquire) != turn) std::this_thread::yield();
+  count_stall(start);
+}
+
+void WorkerPool::count_stall(std::chrono::steady_clock::time_point start) {
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+      std::chrono::steady_clock::now() - start);
+  stalled_ns_.fetch_add(static_cast<std::uint64_t>(ns.count()), std::memory_order_relaxed);
+}
+
+// A pool without workers reads no clock.
+void WorkerPool::begin_step() {
+  busy_.store(true, std::memory_order_relaxed);
+  if (workers_.empty()) return;
+  step_start_ = std::chrono::steady_clock::now();
+  step_cpu_start_ = thread_cpu_ns();
+}
+
+// The step's held-up time: the caller's time off its core (descheduled, or asleep until a
+// worker left a job; its wall time less its CPU time) and every thread's long waits.
+void WorkerPool::end_step() {
+  busy_.store(false, std::memory_order_relaxed);
+  if (workers_.empty()) return;
+  const auto wall = static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() -
+                                                           step_start_)
+          .count());
+  const std::uint64_t cpu = thread_cpu_ns() - step_cpu_start_;
+  const std::uint64_t stalled =
+      stalled_ns_.exchange(0, std::memory_order_relaxed) + (wall > cpu ? wall - cpu : 0);
+  solo_ = policy_.next_solo(wall, stalled);
 }
 
 unsigned hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
@@ -137,10 +194,13 @@ void WorkerPool::work_phases(std::size_t slot) {
     }
     // Every chunk of phase p is taken; wait until they are done (their writes visible).
     if (!phase_barrier_) continue;
-    for (int spins = 0; ph.done.load(std::memory_order_acquire) < ph.chunks; ++spins) {
-      if (spins < kSpinRounds) cpu_relax();
-      else std::this_thread::yield();
-    }
+    int spins = 0;
+    for (; spins < kSpinRounds && ph.done.load(std::memory_order_acquire) < ph.chunks; ++spins)
+      cpu_relax();
+    if (spins < kSpinRounds) continue;
+    const auto start = std::chrono::steady_clock::now();
+    while (ph.done.load(std::memory_order_acquire) < ph.chunks) std::this_thread::yield();
+    count_stall(start);
   }
 }
 

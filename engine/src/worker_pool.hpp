@@ -6,6 +6,7 @@
 /// One thread (the World's owner) submits work; the pool itself is not re-entrant.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <cstdint>
@@ -16,20 +17,48 @@
 
 namespace tumble {
 
-/// Waits until `counter` (read atomically, acquire) equals `turn`: spins, then yields. With
-/// pass_turn, orders the items of a for_each_phase job run without barriers.
-void wait_turn(std::uint32_t& counter, std::uint32_t turn);
-/// Adds one to `counter` (release); only the thread whose turn it was may call it.
+/// Adds one to `counter` (release); only the thread whose turn it was may call it. With
+/// WorkerPool::wait_turn, orders the items of a for_each_phase job run without barriers.
 inline void pass_turn(std::uint32_t& counter) {
   std::atomic_ref<std::uint32_t> c(counter);
   c.store(c.load(std::memory_order_relaxed) + 1, std::memory_order_release);
 }
 
+/// Whether the next step of a pool runs on its caller alone, decided step by step from how
+/// long the threads of the last one were held up waiting for each other (WorkerPool::Busy).
+/// A step's jobs wait for every chunk a thread has taken, and each contact of a sweep for its
+/// bodies' earlier contacts: when the machine has more runnable threads than cores, a worker
+/// descheduled inside a chunk holds the others for its time slice (milliseconds), and `pile`
+/// on two threads beside one busy process took 4.2–4.6 ms a step against one thread's 3.2.
+/// A step held up for more than a quarter of its time sends the next ones to the caller
+/// alone (the same bits: every stage gives the same results on any thread count); then one
+/// step shares again to see whether the cores are free. A stall soon after such a probe
+/// doubles the stretch alone (4 steps up to 512), so a machine that stays busy costs one
+/// held-up step in hundreds. Plain data; used by the pool's owner thread only.
+class SoloPolicy {
+ public:
+  /// Steps alone after the first stall, and at most.
+  static constexpr std::uint32_t kFirst = 4, kMost = 512;
+  /// Shared steps without a stall after which the next stall starts again from kFirst.
+  static constexpr std::uint32_t kRecent = 8;
+
+  /// Called once a step ends with its wall time and the time its threads spent held up
+  /// (ns, summed over threads); returns whether the next step runs on the caller alone.
+  bool next_solo(std::uint64_t wall_ns, std::uint64_t stalled_ns);
+
+ private:
+  std::uint32_t left_ = 0;          // steps alone still to run
+  std::uint32_t length_ = kFirst;   // the last stretch alone
+  std::uint32_t since_ = kRecent;   // shared steps since the last stretch alone (saturating)
+};
+
 /// Worker threads that spin briefly between jobs (a step submits a few hundred small jobs in
 /// a row) and sleep on a futex otherwise. A worker that comes late finds the job done and
-/// skips it: the caller never waits for a thread that has not started, so a busy machine
-/// (more runnable threads than cores) slows a step down to one thread's pace, not below.
-/// Owned by one World; not copyable.
+/// skips it: the caller never waits for a thread that has not started. A worker descheduled
+/// inside a job does hold the others up; steps held up that way send the next ones to the
+/// caller alone for a while (SoloPolicy), so a busy machine (more runnable threads than
+/// cores) slows a step down to about one thread's pace, not far below. Owned by one World;
+/// not copyable.
 class WorkerPool {
  public:
   /// A pool of `threads` − 1 workers plus the calling thread; threads ≥ 1 (1: no workers).
@@ -38,19 +67,27 @@ class WorkerPool {
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
-  /// Threads that share a job, the caller included.
-  unsigned size() const { return static_cast<unsigned>(workers_.size()) + 1; }
+  /// Threads of the pool, the caller included, as constructed.
+  unsigned threads() const { return static_cast<unsigned>(workers_.size()) + 1; }
+  /// Threads that share a job now, the caller included: threads(), or 1 for a step that runs
+  /// on the caller alone (SoloPolicy). Stages choose their one-thread paths by it.
+  unsigned size() const { return solo_ ? 1u : threads(); }
+  /// True while steps run on the caller alone because the last shared one was held up.
+  bool solo() const { return solo_; }
+
+  /// Waits until `counter` (read atomically, acquire) equals `turn`: spins, then yields,
+  /// counting a long wait as held up (SoloPolicy). Any thread of a job.
+  void wait_turn(std::uint32_t& counter, std::uint32_t turn);
 
   /// While held (by the submitting thread, around one World::step), idle workers poll for the
   /// next job up to ~0.2 ms instead of ~25 µs before they sleep: a step's serial stretches
-  /// between jobs outlast the short poll, and each then cost a wake-up. Not nested.
+  /// between jobs outlast the short poll, and each then cost a wake-up. At its end, the step's
+  /// wall time and waits decide whether the next step shares (SoloPolicy). Not nested.
   class Busy {
    public:
     /// Marks `pool` busy until destruction.
-    explicit Busy(WorkerPool& pool) : pool_(pool) {
-      pool_.busy_.store(true, std::memory_order_relaxed);
-    }
-    ~Busy() { pool_.busy_.store(false, std::memory_order_relaxed); }
+    explicit Busy(WorkerPool& pool) : pool_(pool) { pool_.begin_step(); }
+    ~Busy() { pool_.end_step(); }
     Busy(const Busy&) = delete;
     Busy& operator=(const Busy&) = delete;
 
@@ -64,7 +101,7 @@ class WorkerPool {
   template <typename Fn>
   void for_each(std::size_t n, std::size_t grain, Fn&& fn) {
     if (n == 0) return;
-    if (workers_.empty() || n <= grain) return fn(std::size_t{0}, n);
+    if (size() == 1 || n <= grain) return fn(std::size_t{0}, n);
     run(n, grain, &call<Fn>, &fn);
   }
 
@@ -81,7 +118,7 @@ class WorkerPool {
   void for_each_phase(std::size_t phases, std::size_t grain, Size&& size, Fn&& fn,
                       bool barrier = true) {
     phase_barrier_ = barrier;
-    if (workers_.empty()) {
+    if (this->size() == 1) {
       for (std::size_t p = 0; p < phases; ++p) fn(p, std::size_t{0}, static_cast<std::size_t>(size(p)));
       return;
     }
@@ -141,6 +178,10 @@ class WorkerPool {
   void run(std::size_t n, std::size_t grain, Thunk thunk, void* fn);
   void work();
   void worker_main();
+  void begin_step();
+  void end_step();
+  /// Adds the time since `start` to the step's held-up time.
+  void count_stall(std::chrono::steady_clock::time_point start);
 
   std::unique_ptr<Phase[]> phases_;  // the phases of the current for_each_phase job
   std::size_t phase_capacity_ = 0;
@@ -170,6 +211,13 @@ class WorkerPool {
   std::atomic<bool> caller_waiting_{false};  // the caller asleep on job_left_
   std::atomic<bool> stop_{false};
   std::atomic<bool> busy_{false};  // a step is under way: poll longer (Busy)
+  // Held-up time of the step under way (ns, any thread), its start, and what it decides
+  // (the owner's thread only).
+  alignas(64) std::atomic<std::uint64_t> stalled_ns_{0};
+  std::chrono::steady_clock::time_point step_start_{};
+  std::uint64_t step_cpu_start_ = 0;  // the caller's CPU time at the step's start, ns
+  SoloPolicy policy_;
+  bool solo_ = false;
   static constexpr std::uint64_t kClosed = std::uint64_t{1} << 16;
   static constexpr std::uint64_t kInside = kClosed - 1;
   static constexpr std::uint64_t kGeneration = std::uint64_t{1} << 17;

@@ -127,10 +127,10 @@ void World::set_stage_timing(bool on) { time_stages_ = on; }
 
 void World::set_threads(unsigned threads) {
   if (threads == 0) threads = hardware_threads();
-  if (threads != pool_->size()) pool_ = std::make_unique<WorkerPool>(threads);
+  if (threads != pool_->threads()) pool_ = std::make_unique<WorkerPool>(threads);
 }
 
-unsigned World::threads() const { return pool_->size(); }
+unsigned World::threads() const { return pool_->threads(); }
 
 unsigned World::hardware_threads() { return tumble::hardware_threads(); }
 

@@ -41,6 +41,7 @@ void World::step(double dt) {
     pass(dt, last_, nullptr);
     total_impacts_ += last_.impacts;
   }
+  last_.solo = pool_->solo() ? 1 : 0;
   time_ += dt;
   ++steps_;
 }

@@ -1,6 +1,7 @@
 // Worker threads (World::set_threads, engine/src/worker_pool.hpp): every index of a job runs
 // exactly once, and a World steps bit for bit the same on one thread as on several.
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <numeric>
 #include <thread>
@@ -140,6 +141,91 @@ TEST(Threads, PyramidIsBitIdenticalOnOneTwoAndThreeThreads) {
 // Separated boxes: lone bodies flying with the scene's integrator and landing on the floor.
 TEST(Threads, SeparatedBoxesAreBitIdenticalOnOneTwoAndThreeThreads) {
   expect_same_on_any_thread_count(bundled("many"), 240);
+}
+
+// A step whose threads were held up for more than a quarter of its time sends the next
+// kFirst to the caller alone; a stall soon after the probe that follows doubles the stretch,
+// up to kMost; a probe that passes and stays clear for kRecent steps starts again from kFirst.
+TEST(Threads, StepsHeldUpRunAloneForLongerStretchesWhileTheStallsGoOn) {
+  using P = SoloPolicy;
+  P policy;
+  auto alone = [&](std::uint32_t steps) {  // `steps` solo steps, then a shared one
+    for (std::uint32_t i = 1; i < steps; ++i) ASSERT_TRUE(policy.next_solo(1000, 0)) << i;
+    ASSERT_FALSE(policy.next_solo(1000, 0));
+  };
+  EXPECT_FALSE(policy.next_solo(1000, 250));  // a quarter held up: still shared
+  EXPECT_FALSE(policy.next_solo(1000, 0));
+  EXPECT_TRUE(policy.next_solo(1000, 251));
+  alone(P::kFirst);
+  ASSERT_TRUE(policy.next_solo(1000, 900));  // the probe was held up too
+  alone(2 * P::kFirst);
+  for (std::uint32_t n = 4 * P::kFirst; n <= P::kMost; n *= 2) {
+    ASSERT_TRUE(policy.next_solo(1000, 900));
+    alone(n);
+  }
+  ASSERT_TRUE(policy.next_solo(1000, 900));
+  alone(P::kMost);  // no longer than kMost
+  for (std::uint32_t i = 0; i < P::kRecent; ++i) ASSERT_FALSE(policy.next_solo(1000, 0));
+  ASSERT_TRUE(policy.next_solo(1000, 900));
+  alone(P::kFirst);  // the cores were free for a while: the first stretch again
+}
+
+// The pool's own wiring: a worker that holds a job up (asleep inside its chunk, as a
+// descheduled thread would be) makes the next steps run every job on the caller, with
+// size() 1, and a later step shares again.
+TEST(Threads, APoolHeldUpByAWorkerRunsTheNextStepsOnTheCaller) {
+  WorkerPool pool(2);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<bool> held = false;
+  // The caller's chunks spin (its own CPU time, no stall) long enough for the worker to join.
+  auto spin = [](std::chrono::microseconds d) {
+    for (auto end = std::chrono::steady_clock::now() + d; std::chrono::steady_clock::now() < end;) {
+    }
+  };
+  for (int attempt = 0; attempt < 200 && !held; ++attempt) {
+    const WorkerPool::Busy step(pool);
+    pool.for_each_phase(2, 1, [](std::size_t) { return std::size_t{8}; },
+                        [&](std::size_t, std::size_t, std::size_t) {
+                          if (std::this_thread::get_id() == caller) return spin(std::chrono::microseconds(200));
+                          held = true;
+                          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+                        });
+  }
+  ASSERT_TRUE(held) << "no worker joined a job in 200 tries";
+  EXPECT_TRUE(pool.solo());
+  EXPECT_EQ(pool.size(), 1u);
+  EXPECT_EQ(pool.threads(), 2u);
+  // kFirst steps alone, or longer where a stall of the busy machine came shortly before.
+  std::uint32_t alone = 0;
+  for (; pool.solo() && alone <= SoloPolicy::kMost; ++alone) {
+    const WorkerPool::Busy step(pool);
+    bool elsewhere = false;
+    pool.for_each(10000, 1, [&](std::size_t, std::size_t) {
+      elsewhere = elsewhere || std::this_thread::get_id() != caller;
+    });
+    EXPECT_FALSE(elsewhere) << "step " << alone;
+  }
+  EXPECT_GE(alone, SoloPolicy::kFirst);
+  EXPECT_FALSE(pool.solo());
+  EXPECT_EQ(pool.size(), 2u);
+}
+
+// What a step alone relies on: a World whose thread count changes from step to step steps
+// bit for bit as one that keeps one thread.
+TEST(Threads, PileIsBitIdenticalWhenItsThreadCountChangesBetweenSteps) {
+  Scene pile = bundled("pile");
+  pile.bodies.resize(testing::kPileBodies);
+  World steady(pile), changing(pile);
+  for (int i = 1; i <= 90; ++i) {
+    changing.set_threads(i % 7 < 3 ? 1u : 2u);
+    for (World* w : {&steady, &changing}) {
+      if (i % 15 == 0)
+        for (std::size_t b = 0; b < w->bodies().size(); b += 7) w->apply_impulse(BodyId(b), Vec3::Zero());
+      w->step();
+    }
+    expect_identical(steady, changing);
+    if (::testing::Test::HasFatalFailure()) FAIL() << "at step " << i;
+  }
 }
 
 TEST(Threads, CopyKeepsTheThreadCountAndZeroMeansEveryCore) {

@@ -67,6 +67,10 @@ struct StepStats {
   /// 1 when the broad phase stopped at its pair budget (32 per body + 1,024): bodies packed
   /// into one another beyond it were not tested against each other this step.
   std::uint32_t pair_budget_exceeded = 0;
+  /// 1 when the step, in a World of several threads, ran on the calling thread alone: a
+  /// recent step's threads were held up waiting for a descheduled one (a machine with more
+  /// runnable threads than cores; engine/src/worker_pool.hpp, SoloPolicy). The same results.
+  std::uint32_t solo = 0;
   /// Passes of the stages the step ran: 1, more where WorldDef::max_overlap had a pass taken
   /// again as two halves (the counters above are the kept passes'; the times below, all).
   std::uint32_t passes = 0;
