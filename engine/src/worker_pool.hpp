@@ -30,17 +30,21 @@ inline void pass_turn(std::uint32_t& counter) {
 /// bodies' earlier contacts: when the machine has more runnable threads than cores, a worker
 /// descheduled inside a chunk holds the others for its time slice (milliseconds), and `pile`
 /// on two threads beside one busy process took 4.2–4.6 ms a step against one thread's 3.2.
-/// A step held up for more than a quarter of its time sends the next ones to the caller
-/// alone (the same bits: every stage gives the same results on any thread count); then one
+/// A step held up for more than a quarter of its time, and for longer than a wake-up's
+/// latency (kLeastStall: a descheduled thread is away for a time slice, milliseconds, where a
+/// worker woken from its sleep in the first steps holds a job up ~0.25 ms), sends the next
+/// ones to the caller alone (the same bits: every stage gives the same results on any thread count); then one
 /// step shares again to see whether the cores are free. A stall soon after such a probe
-/// doubles the stretch alone (4 steps up to 512), so a machine that stays busy costs one
+/// doubles the stretch alone (2 steps up to 512), so a machine that stays busy costs one
 /// held-up step in hundreds. Plain data; used by the pool's owner thread only.
 class SoloPolicy {
  public:
   /// Steps alone after the first stall, and at most.
-  static constexpr std::uint32_t kFirst = 4, kMost = 512;
+  static constexpr std::uint32_t kFirst = 2, kMost = 512;
   /// Shared steps without a stall after which the next stall starts again from kFirst.
   static constexpr std::uint32_t kRecent = 8;
+  /// The least held-up time of a step that counts as a stall, ns.
+  static constexpr std::uint64_t kLeastStall = 500'000;
 
   /// Called once a step ends with its wall time and the time its threads spent held up
   /// (ns, summed over threads); returns whether the next step runs on the caller alone.

@@ -143,30 +143,33 @@ TEST(Threads, SeparatedBoxesAreBitIdenticalOnOneTwoAndThreeThreads) {
   expect_same_on_any_thread_count(bundled("many"), 240);
 }
 
-// A step whose threads were held up for more than a quarter of its time sends the next
-// kFirst to the caller alone; a stall soon after the probe that follows doubles the stretch,
-// up to kMost; a probe that passes and stays clear for kRecent steps starts again from kFirst.
+// A step whose threads were held up for more than a quarter of its time (and more than
+// kLeastStall) sends the next kFirst to the caller alone; a stall soon after the probe that
+// follows doubles the stretch, up to kMost; a probe that passes and stays clear for kRecent
+// steps starts again from kFirst.
 TEST(Threads, StepsHeldUpRunAloneForLongerStretchesWhileTheStallsGoOn) {
   using P = SoloPolicy;
+  constexpr std::uint64_t kWall = 8 * P::kLeastStall, kLong = 6 * P::kLeastStall;
   P policy;
   auto alone = [&](std::uint32_t steps) {  // `steps` solo steps, then a shared one
-    for (std::uint32_t i = 1; i < steps; ++i) ASSERT_TRUE(policy.next_solo(1000, 0)) << i;
-    ASSERT_FALSE(policy.next_solo(1000, 0));
+    for (std::uint32_t i = 1; i < steps; ++i) ASSERT_TRUE(policy.next_solo(kWall, 0)) << i;
+    ASSERT_FALSE(policy.next_solo(kWall, 0));
   };
-  EXPECT_FALSE(policy.next_solo(1000, 250));  // a quarter held up: still shared
-  EXPECT_FALSE(policy.next_solo(1000, 0));
-  EXPECT_TRUE(policy.next_solo(1000, 251));
+  EXPECT_FALSE(policy.next_solo(kWall, kWall / 4));  // a quarter held up: still shared
+  EXPECT_FALSE(policy.next_solo(P::kLeastStall, P::kLeastStall));  // a wake-up's latency
+  EXPECT_FALSE(policy.next_solo(kWall, 0));
+  EXPECT_TRUE(policy.next_solo(kWall, kWall / 4 + 1));
   alone(P::kFirst);
-  ASSERT_TRUE(policy.next_solo(1000, 900));  // the probe was held up too
+  ASSERT_TRUE(policy.next_solo(kWall, kLong));  // the probe was held up too
   alone(2 * P::kFirst);
   for (std::uint32_t n = 4 * P::kFirst; n <= P::kMost; n *= 2) {
-    ASSERT_TRUE(policy.next_solo(1000, 900));
+    ASSERT_TRUE(policy.next_solo(kWall, kLong));
     alone(n);
   }
-  ASSERT_TRUE(policy.next_solo(1000, 900));
+  ASSERT_TRUE(policy.next_solo(kWall, kLong));
   alone(P::kMost);  // no longer than kMost
-  for (std::uint32_t i = 0; i < P::kRecent; ++i) ASSERT_FALSE(policy.next_solo(1000, 0));
-  ASSERT_TRUE(policy.next_solo(1000, 900));
+  for (std::uint32_t i = 0; i < P::kRecent; ++i) ASSERT_FALSE(policy.next_solo(kWall, 0));
+  ASSERT_TRUE(policy.next_solo(kWall, kLong));
   alone(P::kFirst);  // the cores were free for a while: the first stretch again
 }
 
