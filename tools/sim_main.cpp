@@ -170,12 +170,13 @@ int main(int argc, char** argv) {
   world.set_threads(o.threads);
   const long steps = std::lround(o.duration / scene.world.dt);
   if (csv.is_open()) write_rows(csv, world);
-  std::uint64_t body_steps = 0, passes = 0;
+  std::uint64_t body_steps = 0, passes = 0, steps_alone = 0;
   const auto start = std::chrono::steady_clock::now();
   for (long k = 1; k <= steps; ++k) {
     world.step();
     body_steps += world.bodies().size();
     passes += world.last_step().passes;
+    steps_alone += world.last_step().solo;
     if (csv.is_open() && (k % o.every == 0 || k == steps)) write_rows(csv, world);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -187,6 +188,7 @@ int main(int argc, char** argv) {
       {"max_overlap", scene.world.max_overlap},
       {"passes", passes},
       {"threads", world.threads()},
+      {"steps_alone", steps_alone},
       {"bodies", world.bodies().size()},
       {"impacts", world.total_impacts()},
       {"awake", world.awake_count()},

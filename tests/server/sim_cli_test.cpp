@@ -26,6 +26,7 @@ TEST(SimCli, MaxOverlapBoundsTheStepsAndCountsItsPasses) {
   EXPECT_EQ(line["max_overlap"], 0.01);
   EXPECT_EQ(line["steps"], 45);
   EXPECT_GT(line["passes"].get<int>(), 45);  // the landing's steps were taken in halves
+  EXPECT_EQ(line["steps_alone"], 0);  // one thread has no worker to be held up by
   const auto [plain_code, plain_out] = run_sim({"pile", "--duration", "0.75", "--threads", "1"});
   ASSERT_EQ(plain_code, 0) << plain_out;
   EXPECT_EQ(nlohmann::json::parse(plain_out)["passes"], 45);
