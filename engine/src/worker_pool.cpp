@@ -26,7 +26,8 @@ constexpr int kBusySpinRounds = 1 << 13;
 std::uint64_t thread_cpu_ns() {
   timespec t{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000u + static_cast<std::uint64_t>(t.tv_nsec);
+  return static_cast<std::uint64_t>(t.tv_sec) * 1'000'000'000u +
+         static_cast<std::uint64_t>(t.tv_nsec);
 }
 
 void cpu_relax() {
@@ -53,8 +54,8 @@ bool SoloPolicy::next_solo(std::uint64_t wall_ns, std::uint64_t stalled_ns) {
   return false;
 }
 
-// A wait past its spinning reads the clock once when it starts yielding and once when it
-// ends: waits that short are free of clock reads, and only the long ones count as held up.
+// A wait that outlasts its spinning reads the clock when it starts to yield and when it ends;
+// shorter waits read no clock, and only the long ones count as held up.
 void WorkerPool::wait_turn(std::uint32_t& counter, std::uint32_t turn) {
   const std::atomic_ref<std::uint32_t> c(counter);
   int spins = 0;

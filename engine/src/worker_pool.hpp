@@ -25,18 +25,18 @@ inline void pass_turn(std::uint32_t& counter) {
 }
 
 /// Whether the next step of a pool runs on its caller alone, decided step by step from how
-/// long the threads of the last one were held up waiting for each other (WorkerPool::Busy).
-/// A step's jobs wait for every chunk a thread has taken, and each contact of a sweep for its
-/// bodies' earlier contacts: when the machine has more runnable threads than cores, a worker
-/// descheduled inside a chunk holds the others for its time slice (milliseconds), and `pile`
-/// on two threads beside one busy process took 4.2–4.6 ms a step against one thread's 3.2.
-/// A step held up for more than a quarter of its time, and for longer than a wake-up's
-/// latency (kLeastStall: a descheduled thread is away for a time slice, milliseconds, where a
-/// worker woken from its sleep in the first steps holds a job up ~0.25 ms), sends the next
-/// ones to the caller alone (the same bits: every stage gives the same results on any thread count); then one
-/// step shares again to see whether the cores are free. A stall soon after such a probe
-/// doubles the stretch alone (2 steps up to 512), so a machine that stays busy costs one
-/// held-up step in hundreds. Plain data; used by the pool's owner thread only.
+/// long the threads of the last one were held up (WorkerPool::Busy). A step's jobs wait for
+/// every chunk a thread has taken, and each contact of a sweep for its bodies' earlier
+/// contacts: when the machine has more runnable threads than cores, a worker descheduled
+/// inside a chunk holds the others for its time slice (milliseconds), and the caller loses its
+/// own core part of the time. `pile` on two threads beside one busy process took 4.2–6.1 ms a
+/// step against one thread's 3.2–3.4. A step held up for more than a quarter of its time, and
+/// for longer than kLeastStall (a worker woken from its sleep holds an early step up ~0.25 ms;
+/// a time slice is longer), sends the next ones to the caller alone: the same bits, since
+/// every stage gives the same results on any thread count. Then one step shares again to see
+/// whether the cores are free; a stall soon after it doubles the stretch alone (2 steps up to
+/// 512), so a machine that stays busy costs one held-up step in hundreds. Plain data; used by
+/// the pool's owner thread only.
 class SoloPolicy {
  public:
   /// Steps alone after the first stall, and at most.

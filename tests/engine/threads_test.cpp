@@ -189,7 +189,8 @@ TEST(Threads, APoolHeldUpByAWorkerRunsTheNextStepsOnTheCaller) {
     const WorkerPool::Busy step(pool);
     pool.for_each_phase(2, 1, [](std::size_t) { return std::size_t{8}; },
                         [&](std::size_t, std::size_t, std::size_t) {
-                          if (std::this_thread::get_id() == caller) return spin(std::chrono::microseconds(200));
+                          if (std::this_thread::get_id() == caller)
+                            return spin(std::chrono::microseconds(200));
                           held = true;
                           std::this_thread::sleep_for(std::chrono::milliseconds(5));
                         });
@@ -223,7 +224,8 @@ TEST(Threads, PileIsBitIdenticalWhenItsThreadCountChangesBetweenSteps) {
     changing.set_threads(i % 7 < 3 ? 1u : 2u);
     for (World* w : {&steady, &changing}) {
       if (i % 15 == 0)
-        for (std::size_t b = 0; b < w->bodies().size(); b += 7) w->apply_impulse(BodyId(b), Vec3::Zero());
+        for (std::size_t b = 0; b < w->bodies().size(); b += 7)
+          w->apply_impulse(BodyId(b), Vec3::Zero());
       w->step();
     }
     expect_identical(steady, changing);
