@@ -219,7 +219,8 @@ class WorkerPool {
   // (the owner's thread only).
   alignas(64) std::atomic<std::uint64_t> stalled_ns_{0};
   std::chrono::steady_clock::time_point step_start_{};
-  std::uint64_t step_cpu_start_ = 0;  // the caller's CPU time at the step's start, ns
+  std::uint64_t step_cpu_start_ = 0;  // the caller's CPU time at the step's start, ns (0: unread)
+  std::uint64_t last_wall_ns_ = 0;    // the last step's wall time, ns
   SoloPolicy policy_;
   bool solo_ = false;
   static constexpr std::uint64_t kClosed = std::uint64_t{1} << 16;
