@@ -69,7 +69,7 @@ struct StepStats {
   std::uint32_t pair_budget_exceeded = 0;
   /// 1 when the step, in a World of several threads, ran on the calling thread alone: a
   /// recent step's threads were held up waiting for a descheduled one (a machine with more
-  /// runnable threads than cores; engine/src/worker_pool.hpp, SoloPolicy). The same results.
+  /// runnable threads than cores; engine/src/solo_policy.hpp). The same results.
   std::uint32_t solo = 0;
   /// Passes of the stages the step ran: 1, more where WorldDef::max_overlap had a pass taken
   /// again as two halves (the counters above are the kept passes'; the times below, all).
