@@ -14,13 +14,17 @@ namespace {
 class TumbleAsPeer final : public PeerWorld {
  public:
   TumbleAsPeer(const tumble::Scene& s, unsigned threads) : w_(s) { w_.set_threads(threads); }
-  void step() override { w_.step(); }
+  void step() override {
+    w_.step();
+    alone_ += w_.last_step().solo;
+  }
   PeerBodyState state(std::size_t i) const override {
     const tumble::Body& b = w_.body(static_cast<tumble::BodyId>(i));
     return {b.s.x, Quat(b.s.R), tumble::velocity(b.s, b.c), tumble::angular_velocity(b.s, b.c)};
   }
   long awake_count() const override { return static_cast<long>(w_.awake_count()); }
   long long impacts() const override { return static_cast<long long>(w_.total_impacts()); }
+  long steps_alone() const override { return alone_; }
   /// A zero impulse on every body every 15 steps wakes its island (Tumble has no switch to
   /// turn sleeping off; 15 steps is well below the 0.5 s sleep timer at dt = 1/60).
   void keep_awake(long step) override {
@@ -31,6 +35,7 @@ class TumbleAsPeer final : public PeerWorld {
 
  private:
   tumble::World w_;
+  long alone_ = 0;  // steps run on the calling thread alone (StepStats::solo)
 };
 
 Contender peer_contender(const PeerEngine& p) {

@@ -52,6 +52,9 @@ struct EngineResult {
   /// Wall-clock ms per step of the same runs: what a threaded run's speed-up compares.
   std::vector<double> wall_ms;
   long steps_done = 0;     ///< Fewest steps timed over the repetitions (CPU budget).
+  /// Most timed steps of one repetition run on the calling thread alone (threaded Tumble on a
+  /// busy machine; 0 when none, -1 for an engine without the count).
+  long steps_alone = -1;
   std::string refused;     ///< Why the engine refused or broke in a timed run, else empty.
   Behaviour tower_awake;   ///< Tower only: 60 s kept awake.
   Behaviour sleeping;      ///< With the engine's own sleeping, until asleep or the cap.

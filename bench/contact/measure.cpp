@@ -15,9 +15,10 @@ namespace {
 
 /// CPU seconds per step over `steps` steps of a fresh, kept-awake engine (building it is not
 /// timed); stops early once `budget` CPU seconds are spent (*done: steps actually run;
-/// *wall: wall-clock seconds per step of the same steps).
+/// *wall: wall-clock seconds per step of the same steps; *alone: of those, the steps run on
+/// the calling thread alone, or -1).
 double timed_awake(const Contender& c, const tumble::Scene& s, long steps, double budget,
-                   long* done, double* wall, std::string* why) {
+                   long* done, double* wall, long* alone, std::string* why) {
   std::unique_ptr<PeerWorld> e;
   try {
     e = c.make(s, PeerSetup{.stacking = true, .allow_sleep = false});
@@ -37,6 +38,7 @@ double timed_awake(const Contender& c, const tumble::Scene& s, long steps, doubl
   }
   *done = i - 1;
   *wall = elapsed / static_cast<double>(*done);
+  *alone = e->steps_alone();
   const std::string t = e->trouble();
   if (!t.empty()) *why = t;
   return cpu / static_cast<double>(*done);
@@ -110,13 +112,15 @@ void time_engines(const Measurement& m, const tumble::Scene& s, SceneResult& r, 
     if (e.refused.rfind("MuJoCo 2.2 allocates", 0) == 0) continue;  // refused at build: always
     bar.note(r.spec.name + " " + c.name);
     std::string why;
-    long done = 0;
+    long done = 0, alone = -1;
     double wall = NAN;
-    const double per_step = timed_awake(c, s, r.timed_steps, r.spec.budget, &done, &wall, &why);
+    const double per_step =
+        timed_awake(c, s, r.timed_steps, r.spec.budget, &done, &wall, &alone, &why);
     if (!why.empty()) e.refused = why;
     e.ms.push_back(per_step * 1e3);
     e.wall_ms.push_back(wall * 1e3);
     e.steps_done = e.ms.size() == 1 ? done : std::min(e.steps_done, done);
+    e.steps_alone = std::max(e.steps_alone, alone);
   }
 }
 

@@ -20,14 +20,15 @@ std::vector<std::string> table_row(const Row& r) {
           r.asleep};
 }
 
-/// "Not run or not valid" notes: short timings, refusals, trouble in the sleeping run.
+/// Notes on the runs: short timings, refusals, trouble in the sleeping run, steps alone.
 std::string not_run(const Measurement& m) {
   std::vector<std::string> notes;
   for (const SceneResult& r : m.scenes)
     for (const Row& row : rows(m, r))
       if (!row.note.empty()) notes.push_back("`" + r.spec.name + "` on " + row.engine + ": " +
                                              row.note);
-  return notes.empty() ? "" : "Not run, not valid or timed short:\n\n" + bullet_list(notes);
+  return notes.empty() ? ""
+                       : "Not run, not valid, timed short or run alone:\n\n" + bullet_list(notes);
 }
 
 std::string joined(const Measurement& m, const auto& item) {

@@ -19,6 +19,14 @@ std::string short_timing_note(const SceneResult& r, const EngineResult& e) {
          std::to_string(r.timed_steps) + " steps (CPU budget " + fmt(r.spec.budget) + " s)";
 }
 
+/// A threaded Tumble whose threads were held up ran some steps on the calling thread alone.
+std::string alone_note(const SceneResult& r, const EngineResult& e) {
+  if (e.steps_alone <= 0) return {};
+  return std::to_string(e.steps_alone) + " of its " + std::to_string(r.timed_steps) +
+         " timed steps on the calling thread alone in one repetition (its threads held up: a "
+         "machine busier than its cores, docs/engine.md, \"Threads\")";
+}
+
 /// The first thing that went wrong: a refusal, then trouble in the sleeping or the awake run.
 std::string trouble_of(const SceneResult& r, const EngineResult& e) {
   if (!e.refused.empty()) return e.refused;
@@ -61,7 +69,12 @@ std::vector<Row> rows(const Measurement& m, const SceneResult& r) {
         e.sleeping.end_time < cap_s - 1e-9)
       row.stands += " (first " + fmt(e.sleeping.end_time) + " s)";
     row.asleep = sleep_text(c, e.sleeping);
-    row.note = trouble.empty() ? short_timing_note(r, e) : trouble;
+    if (!trouble.empty()) {
+      row.note = trouble;
+    } else {
+      const std::string timing = short_timing_note(r, e), alone = alone_note(r, e);
+      row.note = timing + (timing.empty() || alone.empty() ? "" : "; ") + alone;
+    }
     out.push_back(row);
   }
   return out;

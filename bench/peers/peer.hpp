@@ -67,6 +67,10 @@ class PeerWorld {
   /// What went wrong so far in a way that changes the simulation (a full contact buffer …),
   /// empty when nothing did.
   virtual std::string trouble() const { return {}; }
+  /// Steps run on the calling thread alone since the world was built, because its threads
+  /// were held up (Tumble on several threads on a busy machine), or -1 when the engine has no
+  /// such count.
+  virtual long steps_alone() const { return -1; }
 };
 
 /// A peer engine: its name, what we set, and a factory.
