@@ -38,26 +38,32 @@ void cpu_relax() {
 #endif
 }
 
-}  // namespace
-
-// A wait that outlasts its spinning reads the clock when it starts to yield and when it ends;
-// shorter waits read no clock, and only the long ones count as held up.
-void WorkerPool::wait_turn(std::uint32_t& counter, std::uint32_t turn) {
-  const std::atomic_ref<std::uint32_t> c(counter);
-  int spins = 0;
-  for (; spins < kSpinRounds; ++spins) {
-    if (c.load(std::memory_order_acquire) == turn) return;
+/// Waits until ready(): spins, then yields. Returns how long it yielded, ns: a wait that
+/// outlasts its spinning reads the clock when it starts to yield and when it ends; shorter
+/// waits read no clock and return 0.
+template <typename Ready>
+std::uint64_t wait_until(Ready ready) {
+  for (int spins = 0; spins < kSpinRounds; ++spins) {
+    if (ready()) return 0;
     cpu_relax();
   }
   const auto start = std::chrono::steady_clock::now();
-  while (c.load(std::memory_order_acquire) != turn) std::this_thread::yield();
-  count_stall(start);
+  while (!ready()) std::this_thread::yield();
+  return static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                        std::chrono::steady_clock::now() - start)
+                                        .count());
 }
 
-void WorkerPool::count_stall(std::chrono::steady_clock::time_point start) {
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-      std::chrono::steady_clock::now() - start);
-  stalled_ns_.fetch_add(static_cast<std::uint64_t>(ns.count()), std::memory_order_relaxed);
+}  // namespace
+
+// Only the long waits count as held up.
+void WorkerPool::wait_turn(std::uint32_t& counter, std::uint32_t turn) {
+  const std::atomic_ref<std::uint32_t> c(counter);
+  count_stall(wait_until([&] { return c.load(std::memory_order_acquire) == turn; }));
+}
+
+void WorkerPool::count_stall(std::uint64_t ns) {
+  if (ns > 0) stalled_ns_.fetch_add(ns, std::memory_order_relaxed);
 }
 
 // A pool without workers reads no clock. The caller's CPU time is a system call (~1 µs on
@@ -186,13 +192,7 @@ void WorkerPool::work_phases(std::size_t slot) {
     }
     // Every chunk of phase p is taken; wait until they are done (their writes visible).
     if (!phase_barrier_) continue;
-    int spins = 0;
-    for (; spins < kSpinRounds && ph.done.load(std::memory_order_acquire) < ph.chunks; ++spins)
-      cpu_relax();
-    if (spins < kSpinRounds) continue;
-    const auto start = std::chrono::steady_clock::now();
-    while (ph.done.load(std::memory_order_acquire) < ph.chunks) std::this_thread::yield();
-    count_stall(start);
+    count_stall(wait_until([&] { return ph.done.load(std::memory_order_acquire) >= ph.chunks; }));
   }
 }
 

@@ -154,8 +154,8 @@ class WorkerPool {
   void worker_main();
   void begin_step();
   void end_step();
-  /// Adds the time since `start` to the step's held-up time.
-  void count_stall(std::chrono::steady_clock::time_point start);
+  /// Adds `ns` of waiting to the step's held-up time (any thread).
+  void count_stall(std::uint64_t ns);
 
   std::unique_ptr<Phase[]> phases_;  // the phases of the current for_each_phase job
   std::size_t phase_capacity_ = 0;
