@@ -79,8 +79,7 @@ void WorkerPool::begin_step() {
 // The step's held-up time: the caller's time off its core (descheduled, or asleep until a
 // worker left a job; its wall time less its CPU time) and every thread's long waits.
 void WorkerPool::end_step() {
-  busy_.store(false, std::memory_order_relaxed);
-  if (workers_.empty()) return;
+  if (workers_.empty()) return busy_.store(false, std::memory_order_relaxed);
   const auto wall = static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() -
                                                            step_start_)
@@ -92,11 +91,44 @@ void WorkerPool::end_step() {
   }
   last_wall_ns_ = wall;
   solo_ = policy_.next_solo(wall, stalled);
+  // Timed only after a long step (a microsecond or two), while the workers still poll (busy_).
+  if (!solo_ && wall > SoloPolicy::kLeastStall && policy_.wants_round_trip())
+    solo_ = policy_.after_round_trip(round_trip_ns());
+  busy_.store(false, std::memory_order_relaxed);
+}
+
+// The ball is one word on a line of its own; the clock is read around all kBounces trips
+// (a clock read costs about what a near round trip does). A worker that does not answer a
+// ball in kSpinRounds is not polling (or went to sleep between two balls): the caller takes
+// the ball back, unless the worker took it meanwhile; either way it ends even.
+std::uint64_t WorkerPool::round_trip_ns() {
+  if (workers_.empty()) return 0;
+  const auto start = std::chrono::steady_clock::now();
+  for (int b = 0; b < kBounces; ++b) {
+    std::uint32_t ball = bounce_.fetch_add(1) + 1;
+    int spins = 0;
+    while (bounce_.load(std::memory_order_acquire) == ball) {
+      if (++spins > kSpinRounds) {
+        bounce_.compare_exchange_strong(ball, ball + 1);
+        return 0;
+      }
+      cpu_relax();
+    }
+  }
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                      std::chrono::steady_clock::now() - start)
+                      .count();
+  return static_cast<std::uint64_t>(ns) / kBounces;
+}
+
+void WorkerPool::answer_bounce() {
+  std::uint32_t ball = bounce_.load(std::memory_order_relaxed);
+  if ((ball & 1) != 0) bounce_.compare_exchange_strong(ball, ball + 1);
 }
 
 unsigned hardware_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
-WorkerPool::WorkerPool(unsigned threads) {
+WorkerPool::WorkerPool(unsigned threads, SoloPolicy policy) : policy_(policy) {
   const unsigned workers = threads > 1 ? threads - 1 : 0;
   workers_.reserve(workers);
   for (unsigned i = 0; i < workers; ++i) workers_.emplace_back([this] { worker_main(); });
@@ -213,6 +245,7 @@ void WorkerPool::worker_main() {
          state = job_.load(std::memory_order_acquire)) {
       if (++spins < kSpinRounds ||
           (spins < kBusySpinRounds && busy_.load(std::memory_order_relaxed))) {
+        answer_bounce();
         cpu_relax();
         continue;
       }

@@ -31,12 +31,13 @@ inline void pass_turn(std::uint32_t& counter) {
 /// skips it: the caller never waits for a thread that has not started. A worker descheduled
 /// inside a job does hold the others up; steps held up that way send the next ones to the
 /// caller alone for a while (SoloPolicy), so a busy machine (more runnable threads than
-/// cores) slows a step down to about one thread's pace, not far below. Owned by one World;
-/// not copyable.
+/// cores) slows a step down to about one thread's pace, not far below; so do timed trials
+/// while the cores are far apart (round_trip_ns). Owned by one World; not copyable.
 class WorkerPool {
  public:
   /// A pool of `threads` − 1 workers plus the calling thread; threads ≥ 1 (1: no workers).
-  explicit WorkerPool(unsigned threads);
+  /// `policy` decides which steps run on the caller alone.
+  explicit WorkerPool(unsigned threads, SoloPolicy policy = SoloPolicy());
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
@@ -48,6 +49,11 @@ class WorkerPool {
   unsigned size() const { return solo_ ? 1u : threads(); }
   /// True while steps run on the caller alone because the last shared one was held up.
   bool solo() const { return solo_; }
+
+  /// The time a cache line takes from the caller to a polling worker and back, ns: the mean
+  /// of kBounces round trips, or 0 when no worker answered the first within ~25 µs (asleep,
+  /// descheduled, or none). Owner thread, between jobs.
+  std::uint64_t round_trip_ns();
 
   /// Waits until `counter` (read atomically, acquire) equals `turn`: spins, then yields,
   /// counting a long wait as held up (SoloPolicy). Any thread of a job.
@@ -152,6 +158,8 @@ class WorkerPool {
   void run(std::size_t n, std::size_t grain, Thunk thunk, void* fn);
   void work();
   void worker_main();
+  /// Hands the caller's ball back (round_trip_ns) if it is out; any worker, while polling.
+  void answer_bounce();
   void begin_step();
   void end_step();
   /// Adds `ns` of waiting to the step's held-up time (any thread).
@@ -191,8 +199,11 @@ class WorkerPool {
   std::chrono::steady_clock::time_point step_start_{};
   std::uint64_t step_cpu_start_ = 0;  // the caller's CPU time at the step's start, ns (0: unread)
   std::uint64_t last_wall_ns_ = 0;    // the last step's wall time, ns
+  // round_trip_ns's ball: odd while it waits for a worker, who makes it even.
+  alignas(64) std::atomic<std::uint32_t> bounce_{0};
   SoloPolicy policy_;
   bool solo_ = false;
+  static constexpr int kBounces = 16;
   static constexpr std::uint64_t kClosed = std::uint64_t{1} << 16;
   static constexpr std::uint64_t kInside = kClosed - 1;
   static constexpr std::uint64_t kGeneration = std::uint64_t{1} << 17;

@@ -173,6 +173,132 @@ TEST(Threads, StepsHeldUpRunAloneForLongerStretchesWhileTheStallsGoOn) {
   alone(P::kFirst);  // the cores were free for a while: the first stretch again
 }
 
+// Far cores: a round trip past the bound starts a trial of kTrialSteps alone, then as many
+// shared; the first step of each side is not timed. Alone a twentieth faster than the mean of
+// the fastest shared steps before and after wins kWonFirst steps alone. After them, four
+// shared steps and a round trip: still far, the stretch's last steps stand against those,
+// and each win doubles the stretch up to kMost. A lost trial doubles the shared steps before
+// the next round trip, up to kMost; near cores never start one.
+TEST(Threads, FarCoresTimeStepsAloneAgainstSharedOnesAndKeepTheFaster) {
+  using P = SoloPolicy;
+  constexpr std::uint64_t kShared = 3'800'000, kAlone = 3'200'000, kMoved = 9'000'000;
+  constexpr std::uint64_t kNear = 60, kFar = 330;  // round trips, ns
+  P policy;
+  auto shared = [&](std::uint32_t steps, std::uint64_t wall) {  // returns the probes asked
+    std::uint32_t probes = 0;
+    for (std::uint32_t i = 0; i < steps; ++i) {
+      EXPECT_FALSE(policy.next_solo(wall, 0)) << i;
+      if (!policy.wants_round_trip()) continue;
+      ++probes;
+      EXPECT_FALSE(policy.after_round_trip(kNear));
+    }
+    return probes;
+  };
+  // Four shared steps at `wall` (ns), the first at `first`, then the round trip `rt`; returns
+  // whether the next step runs alone.
+  auto round_trip = [&](std::uint64_t first, std::uint64_t wall, std::uint64_t rt) {
+    EXPECT_FALSE(policy.next_solo(first, 0));
+    for (int i = 1; i < 4; ++i) EXPECT_FALSE(policy.next_solo(wall, 0));
+    EXPECT_TRUE(policy.wants_round_trip());
+    return policy.after_round_trip(rt);
+  };
+  // A trial once its round trip was far: its steps alone, then its shared ones (each side's
+  // first at `first`); returns the verdict, whether the next step runs alone.
+  auto trial = [&](std::uint64_t first, std::uint64_t alone, std::uint64_t after) {
+    EXPECT_TRUE(policy.next_solo(first, 0));
+    for (std::uint32_t i = 2; i < P::kTrialSteps; ++i) EXPECT_TRUE(policy.next_solo(alone, 0));
+    EXPECT_FALSE(policy.next_solo(alone, 0));  // the trial's last step alone
+    EXPECT_FALSE(policy.next_solo(first, 0));
+    for (std::uint32_t i = 2; i < P::kTrialSteps; ++i) EXPECT_FALSE(policy.next_solo(after, 0));
+    EXPECT_FALSE(policy.wants_round_trip());
+    return policy.next_solo(after, 0);
+  };
+  auto alone = [&](std::uint32_t steps) {  // `steps` solo steps, then a shared one
+    for (std::uint32_t i = 1; i < steps; ++i) ASSERT_TRUE(policy.next_solo(kAlone, 0)) << i;
+    ASSERT_FALSE(policy.next_solo(kAlone, 0));
+  };
+  // Near cores: a round trip every kProbeEvery shared steps once three have run, no trial.
+  EXPECT_EQ(shared(4 + 3 * P::kProbeEvery, kShared), 4u);
+  while (!policy.wants_round_trip()) ASSERT_FALSE(policy.next_solo(kShared, 0));
+  EXPECT_FALSE(policy.after_round_trip(0));  // nobody answered: not far
+  EXPECT_EQ(shared(P::kProbeEvery - 4, kShared), 0u);
+  // Far, the working set's moves slow and untimed: won; each recheck won doubles the stretch.
+  ASSERT_TRUE(round_trip(kShared, kShared, kFar));
+  ASSERT_TRUE(trial(kMoved, kAlone, kShared));
+  alone(P::kWonFirst);
+  for (std::uint32_t n = 2 * P::kWonFirst; n <= 2 * P::kMost; n *= 2) {
+    ASSERT_TRUE(round_trip(kMoved, kShared, kFar));
+    alone(std::min(n, P::kMost));
+  }
+  // The cores near again after a stretch: no recheck, and shared from then on.
+  ASSERT_FALSE(round_trip(kMoved, 2'000'000, kNear));
+  EXPECT_EQ(shared(2 * P::kProbeEvery, 2'000'000), 2u);
+  // A step that grows steadily: shared 3.0 ms before the trial and 4.4 after, alone 3.2 at its
+  // middle, 3.7 in the mean: won, where the steps before alone would have lost it.
+  while (!policy.wants_round_trip()) ASSERT_FALSE(policy.next_solo(3'000'000, 0));
+  ASSERT_TRUE(policy.after_round_trip(kFar));
+  ASSERT_TRUE(trial(kMoved, kAlone, 4'400'000));
+  alone(P::kWonFirst);  // a first win again: the cores were near between
+  // A recheck lost: the stretch's 3.2 ms alone against 3.3 shared since.
+  ASSERT_FALSE(round_trip(kMoved, 3'300'000, kFar));
+  // Sharing pays though the cores stay far: alone 1.95 ms against 2.0 is not a twentieth
+  // faster, though each side's first step (untimed) was fast; each loss doubles the shared
+  // steps to the next round trip.
+  for (std::uint32_t gap = 2 * P::kProbeEvery, losses = 0; losses < 7; ++losses) {
+    std::uint32_t waited = 0;
+    for (; !policy.wants_round_trip(); ++waited) ASSERT_FALSE(policy.next_solo(2'000'000, 0));
+    EXPECT_EQ(waited, gap);
+    ASSERT_TRUE(policy.after_round_trip(kFar));
+    ASSERT_FALSE(trial(1'000'000, 1'950'000, 2'000'000));
+    gap = std::min(2 * gap, P::kMost);
+  }
+}
+
+// The wiring of the trials: a pool whose every round trip counts as far runs kTrialSteps
+// steps alone after its round trip, every job on the caller; a worker that polls answers the
+// round trip, and a pool without one measures none.
+TEST(Threads, APoolOnFarCoresRunsATrialOnTheCaller) {
+  EXPECT_EQ(WorkerPool(1).round_trip_ns(), 0u);
+  WorkerPool pool(2, SoloPolicy(/*far_round_trip_ns=*/1));
+  const std::thread::id caller = std::this_thread::get_id();
+  auto spin = [](std::chrono::microseconds d) {
+    for (auto end = std::chrono::steady_clock::now() + d; std::chrono::steady_clock::now() < end;) {
+    }
+  };
+  // Steps past kLeastStall, each a job the worker may join: the worker polls at their ends.
+  auto step = [&] {
+    const WorkerPool::Busy busy(pool);
+    bool elsewhere = false;
+    pool.for_each(64, 1, [&](std::size_t begin, std::size_t end) {
+      spin(std::chrono::microseconds(20 * (end - begin)));
+      if (std::this_thread::get_id() != caller) elsewhere = true;
+    });
+    return elsewhere;
+  };
+  int shared = 0, alone_in_a_row = 0, most_in_a_row = 0;
+  for (int i = 0; i < 400 && most_in_a_row < static_cast<int>(SoloPolicy::kTrialSteps); ++i) {
+    const bool solo = pool.solo();
+    const bool elsewhere = step();
+    if (solo) {
+      EXPECT_FALSE(elsewhere) << "step " << i << " ran alone";
+    }
+    shared += !solo;
+    alone_in_a_row = solo ? alone_in_a_row + 1 : 0;
+    most_in_a_row = std::max(most_in_a_row, alone_in_a_row);
+  }
+  EXPECT_GE(most_in_a_row, static_cast<int>(SoloPolicy::kTrialSteps)) << "no trial in 400 steps";
+  EXPECT_GE(shared, 4);
+  // Within a step, a worker that has just run a job polls a while: it answers.
+  std::uint64_t rt = 0;
+  for (int i = 0; i < 1000 && rt == 0; ++i) {
+    const WorkerPool::Busy busy(pool);
+    pool.for_each(64, 1, [&](std::size_t, std::size_t) { spin(std::chrono::microseconds(5)); });
+    rt = pool.round_trip_ns();
+  }
+  EXPECT_GT(rt, 0u);
+  EXPECT_LT(rt, 10'000'000u);
+}
+
 // The pool's own wiring: a worker that holds a job up (asleep inside its chunk, as a
 // descheduled thread would be) makes the next steps run every job on the caller, with
 // size() 1, and a later step shares again.
