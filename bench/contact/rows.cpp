@@ -19,12 +19,12 @@ std::string short_timing_note(const SceneResult& r, const EngineResult& e) {
          std::to_string(r.timed_steps) + " steps (CPU budget " + fmt(r.spec.budget) + " s)";
 }
 
-/// A threaded Tumble whose threads were held up ran some steps on the calling thread alone.
+/// A threaded Tumble ran some steps on the calling thread alone (held up, or far cores).
 std::string alone_note(const SceneResult& r, const EngineResult& e) {
   if (e.steps_alone <= 0) return {};
   return std::to_string(e.steps_alone) + " of its " + std::to_string(r.timed_steps) +
-         " timed steps on the calling thread alone in one repetition (its threads held up: a "
-         "machine busier than its cores, docs/engine.md, \"Threads\")";
+         " timed steps on the calling thread alone in one repetition (its threads held up on "
+         "a machine busier than its cores, or cores far apart: docs/engine.md, \"Threads\")";
 }
 
 /// The first thing that went wrong: a refusal, then trouble in the sleeping or the awake run.
