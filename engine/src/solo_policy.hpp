@@ -49,6 +49,9 @@ class SoloPolicy {
   /// Shared steps between round trips; steps alone in a trial (the first not timed); steps
   /// alone after the first trial won.
   static constexpr std::uint32_t kProbeEvery = 16, kTrialSteps = 4, kWonFirst = 16;
+  /// The shortest step after which the pool times a round trip, ns: one takes 1–6 µs, under
+  /// 0.4 % of this every kProbeEvery steps (`pyramid`'s steps are ~0.45 ms, `tower`'s 0.01).
+  static constexpr std::uint64_t kLeastProbed = 100'000;
 
   /// A policy whose cores count as far past `far_round_trip_ns` (tests set it to force trials).
   explicit SoloPolicy(std::uint64_t far_round_trip_ns = kFarRoundTrip)

@@ -265,7 +265,7 @@ TEST(Threads, APoolOnFarCoresRunsATrialOnTheCaller) {
     for (auto end = std::chrono::steady_clock::now() + d; std::chrono::steady_clock::now() < end;) {
     }
   };
-  // Steps past kLeastStall, each a job the worker may join: the worker polls at their ends.
+  // Steps past kLeastProbed, each a job the worker may join: the worker polls at their ends.
   auto step = [&] {
     const WorkerPool::Busy busy(pool);
     bool elsewhere = false;
