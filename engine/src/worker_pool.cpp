@@ -92,8 +92,11 @@ void WorkerPool::end_step() {
   last_wall_ns_ = wall;
   solo_ = policy_.next_solo(wall, stalled);
   // Timed only after a long step (a microsecond or two), while the workers still poll (busy_).
-  if (!solo_ && wall > SoloPolicy::kLeastProbed && policy_.wants_round_trip())
-    solo_ = policy_.after_round_trip(round_trip_ns());
+  if (!solo_ && wall > SoloPolicy::kLeastProbed && policy_.wants_round_trip()) {
+    const std::uint64_t round_trip = round_trip_ns();
+    round_trips_ += round_trip > 0;
+    solo_ = policy_.after_round_trip(round_trip);
+  }
   busy_.store(false, std::memory_order_relaxed);
 }
 

@@ -54,6 +54,8 @@ class WorkerPool {
   /// of kBounces round trips, or 0 when no worker answered the first within ~25 µs (asleep,
   /// descheduled, or none). Owner thread, between jobs.
   std::uint64_t round_trip_ns();
+  /// Round trips timed at the ends of steps that a worker answered (SoloPolicy). Owner thread.
+  std::uint64_t round_trips() const { return round_trips_; }
 
   /// Waits until `counter` (read atomically, acquire) equals `turn`: spins, then yields,
   /// counting a long wait as held up (SoloPolicy). Any thread of a job.
@@ -201,6 +203,7 @@ class WorkerPool {
   std::uint64_t last_wall_ns_ = 0;    // the last step's wall time, ns
   // round_trip_ns's ball: odd while it waits for a worker, who makes it even.
   alignas(64) std::atomic<std::uint32_t> bounce_{0};
+  std::uint64_t round_trips_ = 0;  // round trips answered at the ends of steps
   SoloPolicy policy_;
   bool solo_ = false;
   static constexpr int kBounces = 16;
