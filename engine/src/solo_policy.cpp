@@ -22,7 +22,7 @@ bool SoloPolicy::next_solo(std::uint64_t wall_ns, std::uint64_t stalled_ns) {
     }
     return left_ > 0;
   }
-  if (4 * stalled_ns > wall_ns && stalled_ns > kLeastStall) {
+  if (4 * stalled_ns > wall_ns && stalled_ns > least_stall_ns_) {
     length_ = since_ < kRecent ? std::min(2 * length_, kMost) : kFirst;
     left_ = length_;
     after_left_ = 0;  // a trial's shared steps, or those after a won stretch, held up: no verdict

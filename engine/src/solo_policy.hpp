@@ -53,9 +53,11 @@ class SoloPolicy {
   /// 0.4 % of this every kProbeEvery steps (`pyramid`'s steps are ~0.45 ms, `tower`'s 0.01).
   static constexpr std::uint64_t kLeastProbed = 100'000;
 
-  /// A policy whose cores count as far past `far_round_trip_ns` (tests set it to force trials).
-  explicit SoloPolicy(std::uint64_t far_round_trip_ns = kFarRoundTrip)
-      : far_round_trip_ns_(far_round_trip_ns) {}
+  /// A policy whose cores count as far past `far_round_trip_ns` and whose steps count as held
+  /// up past `least_stall_ns` (tests set them to force trials, and to keep stalls out of one).
+  explicit SoloPolicy(std::uint64_t far_round_trip_ns = kFarRoundTrip,
+                      std::uint64_t least_stall_ns = kLeastStall)
+      : far_round_trip_ns_(far_round_trip_ns), least_stall_ns_(least_stall_ns) {}
 
   /// Called once a step ends with its wall time and the time its threads spent held up
   /// (ns, summed over threads); returns whether the next step runs on the caller alone.
@@ -74,6 +76,7 @@ class SoloPolicy {
   bool verdict(std::uint64_t before_ns, std::uint64_t after_ns, std::uint64_t alone_ns);
 
   std::uint64_t far_round_trip_ns_;
+  std::uint64_t least_stall_ns_;
   std::uint32_t left_ = 0;          // steps alone still to run (a stall's or a won trial's)
   std::uint32_t length_ = kFirst;   // the last stretch alone after a stall
   std::uint32_t since_ = kRecent;   // shared steps since the last stretch alone (saturating)
