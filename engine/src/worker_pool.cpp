@@ -91,7 +91,7 @@ void WorkerPool::end_step() {
   }
   last_wall_ns_ = wall;
   solo_ = policy_.next_solo(wall, stalled);
-  // Timed only after a long step (a microsecond or two), while the workers still poll (busy_).
+  // A round trip (1–6 µs) only after a step past kLeastProbed, while the workers still poll.
   if (!solo_ && wall > SoloPolicy::kLeastProbed && policy_.wants_round_trip()) {
     const std::uint64_t round_trip = round_trip_ns();
     round_trips_ += round_trip > 0;

@@ -51,7 +51,7 @@ class WorkerPool {
   bool solo() const { return solo_; }
 
   /// The time a cache line takes from the caller to a polling worker and back, ns: the mean
-  /// of kBounces round trips, or 0 when no worker answered the first within ~25 µs (asleep,
+  /// of kBounces round trips, or 0 when some ball went unanswered for ~25 µs (a worker asleep,
   /// descheduled, or none). Owner thread, between jobs.
   std::uint64_t round_trip_ns();
   /// Round trips timed at the ends of steps that a worker answered (SoloPolicy). Owner thread.
