@@ -296,11 +296,11 @@ Target parse_target(std::string_view path) {
   if (path.starts_with(kWorlds)) {
     const std::string_view rest = path.substr(kWorlds.size());
     const std::size_t slash = rest.find('/');
-    if (slash == std::string_view::npos) return {Target::Kind::world, rest};
+    if (slash == std::string_view::npos) return {.kind = Target::Kind::world, .id = rest};
     return {Target::Kind::world_route, rest.substr(0, slash), nullptr, rest.substr(slash)};
   }
   for (const ServerRoute& r : kServerRoutes)
-    if (r.path == path) return {Target::Kind::server, {}, &r};
+    if (r.path == path) return {.kind = Target::Kind::server, .server = &r};
   if (path.starts_with("/api/"))
     return {Target::Kind::world_route, kDefaultWorld, nullptr, path.substr(4)};
   return {};

@@ -64,12 +64,12 @@ constexpr std::array<std::string_view, 6> kServedModuleFiles{
 StaticLookup resolve_static(const std::filesystem::path& root, std::string_view target) {
   namespace fs = std::filesystem;
   target = target.substr(0, target.find_first_of("?#"));
-  if (target.empty() || target.front() != '/') return {400, {}};
+  if (target.empty() || target.front() != '/') return {.status = 400};
   const std::optional<std::string> decoded = percent_decode(target);
-  if (!decoded) return {400, {}};
+  if (!decoded) return {.status = 400};
   std::string path = *decoded;
   if (path.find('\0') != std::string::npos || path.find('\\') != std::string::npos)
-    return {403, {}};
+    return {.status = 403};
   if (path.back() == '/') path += "index.html";
 
   // Every segment must be a plain name: no "..", ".", or empty segments ("//").
@@ -78,8 +78,8 @@ StaticLookup resolve_static(const std::filesystem::path& root, std::string_view 
   for (; start <= path.size();) {
     const std::size_t end = std::min(path.find('/', start), path.size());
     const std::string_view segment(path.data() + start, end - start);
-    if (segment.empty() || segment.front() == '.') return {403, {}};
-    if (segment == "node_modules" && !relative.empty()) return {403, {}};  // Only at the top.
+    if (segment.empty() || segment.front() == '.') return {.status = 403};
+    if (segment == "node_modules" && !relative.empty()) return {.status = 403};  // Only at the top.
     relative /= fs::path(std::string(segment));
     start = end + 1;
   }
@@ -89,13 +89,13 @@ StaticLookup resolve_static(const std::filesystem::path& root, std::string_view 
   if (*relative.begin() == "node_modules" &&
       std::find(kServedModuleFiles.begin(), kServedModuleFiles.end(),
                 std::string_view(path).substr(1)) == kServedModuleFiles.end())
-    return {403, {}};
+    return {.status = 403};
 
   std::error_code ec;
   const fs::path resolved = fs::canonical(root / relative, ec);  // Follows symlinks.
-  if (ec) return {404, {}};
-  if (!inside(root, resolved)) return {403, {}};
-  if (!fs::is_regular_file(resolved, ec)) return {404, {}};
+  if (ec) return {.status = 404};
+  if (!inside(root, resolved)) return {.status = 403};
+  if (!fs::is_regular_file(resolved, ec)) return {.status = 404};
   return {200, resolved, resolved.lexically_relative(root)};
 }
 

@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 mode=${1:-all}
 case "$mode" in all | server) ;; *) echo "usage: tools/setup.sh [server]" >&2; exit 2 ;; esac
 
-packages=(build-essential cmake ninja-build pkg-config git ca-certificates
+packages=(build-essential clang cmake ninja-build pkg-config git ca-certificates
   libboost1.81-dev libboost-program-options1.81-dev libeigen3-dev nlohmann-json3-dev
   zlib1g-dev nodejs)
 if [ "$mode" = all ]; then

@@ -16,7 +16,7 @@ std::vector<ScalingRow> scaling_rows(const Measurement& m) {
         head.push_back(r.ns_per_body_step_head);
         awake.push_back(r.ns_per_body_step / std::max(r.awake_fraction, 1e-12));
       }
-      ScalingRow row{shape, n};
+      ScalingRow row{.shape = shape, .n = n};
       row.full = n < m.cfg.n_big;
       row.steps = row.full ? m.cfg.steps : m.cfg.head_steps;
       row.runs = rs.size();
