@@ -115,14 +115,14 @@ TEST(ActiveSet, OnePointGetsTheGeneralSolvesImpulseToTheBit) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 2000; ++trial) {
-    const Vec3 normal = Vec3(u(rng), u(rng), u(rng)).normalized();
+    const Vec3 normal = Vec3{u(rng), u(rng), u(rng)}.normalized();
     Vec3 t1, t2;
     tangents(normal, t1, t2);
     const Mat3 A = Mat3::Random() + 2.0 * Mat3::Identity();
     ContactSide side;
     side.inv_mass = 0.1 + std::abs(u(rng));
     side.inv_inertia = A * A.transpose();  // symmetric positive definite
-    side.origin_offset = 0.7 * Vec3(u(rng), u(rng), u(rng));
+    side.origin_offset = 0.7 * Vec3{u(rng), u(rng), u(rng)};
     const Vec3 offset = Vec3::Zero();  // one point is its own origin
     const NormalSystem sys = make_normal_system(normal, t1, t2, &offset, 1, nullptr, &side);
     ActiveSetCache cache(sys);

@@ -69,7 +69,7 @@ double brute_distance(const BodyState& a, const Vec3& ha, const BodyState& b, co
 /// A rotation drawn from a uniform quaternion direction.
 Mat3 random_rotation(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  return Quat(Eigen::Vector4d(unit(rng), unit(rng), unit(rng), unit(rng)).normalized())
+  return Quat(Eigen::Vector4d{unit(rng), unit(rng), unit(rng), unit(rng)}.normalized())
       .toRotationMatrix();
 }
 
@@ -83,10 +83,12 @@ TEST(BoxDistance, IsTheLeastDistanceBetweenTheBoxes) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0), half(0.1, 0.6), apart(0.3, 1.3);
   int tested = 0;
   for (int k = 0; k < 3000; ++k) {
-    const Vec3 ha(half(rng), half(rng), half(rng)), hb(half(rng), half(rng), half(rng));
-    const BodyState a = pose(Vec3(unit(rng), unit(rng), unit(rng)), random_rotation(rng));
-    const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
-    const BodyState b = pose(a.x + apart(rng) * (ha.norm() + hb.norm()) * dir, random_rotation(rng));
+    const Vec3 ha{half(rng), half(rng), half(rng)}, hb{half(rng), half(rng), half(rng)};
+    const Vec3 at{unit(rng), unit(rng), unit(rng)};
+    const BodyState a = pose(at, random_rotation(rng));
+    const Vec3 dir = Vec3{unit(rng), unit(rng), unit(rng)}.normalized();
+    const double gap = apart(rng);
+    const BodyState b = pose(a.x + gap * (ha.norm() + hb.norm()) * dir, random_rotation(rng));
     if (box_depth(a, box(ha), b, box(hb), -INFINITY) >= 0.0) continue;  // they overlap
     ++tested;
     const BoxNearest near = box_nearest(a, box(ha), b, box(hb));
@@ -109,10 +111,10 @@ TEST(BoxDistance, NoManifoldPointIsNearerThanTheSkipAssumes) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0), half(0.1, 0.6), wanted(0.0, 0.05);
   int skipped = 0;
   for (int k = 0; k < 20000; ++k) {
-    const BodyConstants ca = box(Vec3(half(rng), half(rng), half(rng)));
-    const BodyConstants cb = box(Vec3(half(rng), half(rng), half(rng)));
+    const BodyConstants ca = box(Vec3{half(rng), half(rng), half(rng)});
+    const BodyConstants cb = box(Vec3{half(rng), half(rng), half(rng)});
     const BodyState a = pose(Vec3::Zero(), random_rotation(rng));
-    const Vec3 dir = Vec3(unit(rng), unit(rng), unit(rng)).normalized();
+    const Vec3 dir = Vec3{unit(rng), unit(rng), unit(rng)}.normalized();
     BodyState b = pose(Vec3::Zero(), random_rotation(rng));
     // Slide b out along dir until the boxes are apart, then a random gap up to 5 cm further.
     double lo = 0.0, hi = 2.0 * (ca.half_extents.norm() + cb.half_extents.norm());

@@ -122,8 +122,8 @@ TEST(BroadPhase, SlabsAcrossTheSweepFindEveryPairOnceAndAnswerQueries) {
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     for (int q = 0; q < 200; ++q) {
-      const Vec3 centre(66.0 * unit(rng) - 3.0, 2.0 * unit(rng), 66.0 * unit(rng) - 3.0);
-      const Vec3 half(0.2 + (q % 10 == 0 ? 12.0 : 1.0) * unit(rng), 1.0, 0.3 + unit(rng));
+      const Vec3 centre{66.0 * unit(rng) - 3.0, 2.0 * unit(rng), 66.0 * unit(rng) - 3.0};
+      const Vec3 half{0.2 + (q % 10 == 0 ? 12.0 : 1.0) * unit(rng), 1.0, 0.3 + unit(rng)};
       const Aabb box{centre - half, centre + half};
       std::vector<std::uint32_t> found;
       boxes_near(scratch, b.boxes, box, found);
@@ -170,7 +170,7 @@ Scene thrown_boxes(std::size_t n, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   auto spread = [&](double half) {
-    return Vec3(half * (2 * unit(rng) - 1), half * (2 * unit(rng) - 1), half * (2 * unit(rng) - 1));
+    return Vec3{half * (2 * unit(rng) - 1), half * (2 * unit(rng) - 1), half * (2 * unit(rng) - 1)};
   };
   Scene scene;
   scene.world.dt = 1.0 / 120.0;
@@ -180,7 +180,8 @@ Scene thrown_boxes(std::size_t n, unsigned seed) {
     b.name = "b" + std::to_string(i);
     b.size = i % 3 == 0 ? Vec3(1.6, 0.3, 0.5) : Vec3(1.0, 1.0, 1.0);
     b.position = Vec3(0.0, 9.0, 0.0) + spread(6.0);
-    b.orientation = Quat(Eigen::AngleAxisd(3.0 * unit(rng), spread(1.0).normalized()));
+    const double angle = 3.0 * unit(rng);
+    b.orientation = Quat(Eigen::AngleAxisd(angle, spread(1.0).normalized()));
     b.velocity = spread(2.0);
     b.angular_velocity = spread(3.0);
     scene.bodies.push_back(b);
@@ -293,8 +294,10 @@ Scene separated_cubes(int side, int layers, double spacing, unsigned seed, bool 
     b.position = Vec3(spacing * (i % side), drop + spacing * (i / (side * side)),
                       spacing * ((i / side) % side));
     if (spin) {
-      b.orientation = Quat(Eigen::AngleAxisd(3.0 * unit(rng), Vec3(unit(rng), 1.0, unit(rng)).normalized()));
-      b.angular_velocity = Vec3(3.0 * unit(rng), 3.0 * unit(rng), 3.0 * unit(rng));
+      const double angle = 3.0 * unit(rng);
+      const Vec3 axis = Vec3{unit(rng), 1.0, unit(rng)}.normalized();
+      b.orientation = Quat(Eigen::AngleAxisd(angle, axis));
+      b.angular_velocity = Vec3{3.0 * unit(rng), 3.0 * unit(rng), 3.0 * unit(rng)};
     }
     scene.bodies.push_back(b);
   }

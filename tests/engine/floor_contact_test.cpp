@@ -610,8 +610,9 @@ SlidingEdges sliding_edges(int count) {
                       Quat(Eigen::AngleAxisd(tilt, Vec3::UnitZ()));
     const Vec3 along = def.orientation * Vec3::UnitZ();  // the edge on the floor
     const Vec3 across = Vec3::UnitY().cross(along);
-    def.velocity = uniform(0.2, 3.0) * along + uniform(-0.3, 0.3) * across -
-                   uniform(0.05, 0.5) * Vec3::UnitY();
+    const double forward = uniform(0.2, 3.0), sideways = uniform(-0.3, 0.3);
+    const double down = uniform(0.05, 0.5);
+    def.velocity = forward * along + sideways * across - down * Vec3::UnitY();
     def.angular_velocity = {uniform(-1.0, 1.0), uniform(-1.0, 1.0), uniform(-1.0, 1.0)};
     const BodyConstants c = make_body_constants(def, 0.0, 1.0);
     BodyState s = make_body_state(def, c);

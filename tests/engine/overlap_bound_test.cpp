@@ -52,7 +52,7 @@ TEST(BoxDepth, IsTheLeastOverlapOverTheFifteenAxes) {
   int overlapping = 0;
   for (int k = 0; k < 2000; ++k) {
     const BodyState a = pose({u(rng), u(rng), u(rng)}, Quat::UnitRandom());
-    const BodyState b = pose(a.x + 0.8 * Vec3(u(rng), u(rng), u(rng)), Quat::UnitRandom());
+    const BodyState b = pose(a.x + 0.8 * Vec3{u(rng), u(rng), u(rng)}, Quat::UnitRandom());
     const double expected = depth_by_axes(a, ca.half_extents, b, cb.half_extents);
     const double depth = box_depth(a, ca, b, cb, -INFINITY);
     ASSERT_NEAR(depth, expected, 1e-12) << k;

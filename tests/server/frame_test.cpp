@@ -120,9 +120,10 @@ TEST(Frame, VertexErrorWithinATenthOfAMillimetre) {
   for (int i = 0; i < 200; ++i) {
     BodyDef b;
     b.name = "b" + std::to_string(i);
-    b.size = Vec3(size(random), size(random), i % 4 == 0 ? 10.0 : size(random));
-    b.position = Vec3(where(random), where(random), where(random));
-    b.orientation = Quat(unit(random), unit(random), unit(random), unit(random)).normalized();
+    b.size = Vec3{size(random), size(random), i % 4 == 0 ? 10.0 : size(random)};
+    b.position = Vec3{where(random), where(random), where(random)};
+    const double w = unit(random), x = unit(random), y = unit(random), z = unit(random);
+    b.orientation = Quat(w, x, y, z).normalized();
     scene.bodies.push_back(b);
   }
   World world(scene);
