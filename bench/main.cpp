@@ -186,8 +186,8 @@ std::string page_command_line(const Invocation& inv) {
   if (!inv.default_paths) return bench;
   const std::string box3d = kWithBox3d ? " -DTUMBLE_BOX3D_ROOT=../box3d" : "";
   return "cmake -S . -B build/bench -G Ninja -DCMAKE_BUILD_TYPE=Release "
-         "-DCMAKE_CXX_COMPILER=clang++ -DTUMBLE_BUILD_SERVER=OFF" + box3d + " && ninja -C build/bench tumble-bench && "
-         "build/bench/bench/" + bench;
+         "-DCMAKE_CXX_COMPILER=clang++ -DTUMBLE_BUILD_SERVER=OFF" +
+         box3d + " && ninja -C build/bench tumble-bench && build/bench/bench/" + bench;
 }
 
 }  // namespace
